@@ -1,0 +1,142 @@
+#include "sdfkit/core/mesh.hpp"
+
+#include "sdfkit/core/error.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace sdfkit {
+
+float Aabb::diagonal() const { return glm::length(max - min); }
+
+Aabb bounding_box(std::span<const glm::vec3> positions) {
+  Aabb box;
+  if (positions.empty()) return box;
+  box.min = box.max = positions[0];
+  for (const glm::vec3& p : positions) {
+    box.min = glm::min(box.min, p);
+    box.max = glm::max(box.max, p);
+  }
+  return box;
+}
+
+bool triangle_is_degenerate(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  const glm::vec3 e0 = b - a, e1 = c - a, e2 = c - b;
+  const float longest2 = std::max({glm::dot(e0, e0), glm::dot(e1, e1), glm::dot(e2, e2)});
+  const float twice_area = glm::length(glm::cross(e0, e1));
+  // NaN-safe: a NaN area or edge makes the comparison false, so test the accepting form.
+  return !(twice_area > kDegenerateRatio * longest2) || !(longest2 > 0.0f);
+}
+
+namespace {
+bool in_range(const Mesh& mesh, const Triangle& t) {
+  const auto n = mesh.positions.size();
+  return t[0] < n && t[1] < n && t[2] < n;
+}
+}  // namespace
+
+std::vector<std::uint8_t> degenerate_faces(const Mesh& mesh) {
+  std::vector<std::uint8_t> out(mesh.triangles.size(), 0);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const Triangle& t = mesh.triangles[f];
+    out[f] = !in_range(mesh, t) ||
+             triangle_is_degenerate(mesh.positions[t[0]], mesh.positions[t[1]],
+                                    mesh.positions[t[2]]);
+  }
+  return out;
+}
+
+std::vector<glm::vec3> face_normals(const Mesh& mesh) {
+  std::vector<glm::vec3> out(mesh.triangles.size(), glm::vec3(0.0f));
+  const auto degenerate = degenerate_faces(mesh);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (degenerate[f]) continue;
+    const Triangle& t = mesh.triangles[f];
+    const glm::vec3& a = mesh.positions[t[0]];
+    out[f] = glm::normalize(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
+  }
+  return out;
+}
+
+std::vector<float> face_areas(const Mesh& mesh) {
+  std::vector<float> out(mesh.triangles.size(), 0.0f);
+  const auto degenerate = degenerate_faces(mesh);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (degenerate[f]) continue;
+    const Triangle& t = mesh.triangles[f];
+    const glm::vec3& a = mesh.positions[t[0]];
+    out[f] = 0.5f * glm::length(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
+  }
+  return out;
+}
+
+namespace {
+// Interior angle at corner a of triangle (a, b, c), radians, robust for obtuse angles.
+float corner_angle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  const glm::vec3 u = b - a, v = c - a;
+  return std::atan2(glm::length(glm::cross(u, v)), glm::dot(u, v));
+}
+}  // namespace
+
+std::vector<glm::vec3> vertex_normals(const Mesh& mesh) {
+  std::vector<glm::dvec3> sum(mesh.positions.size(), glm::dvec3(0.0));
+  const auto normals = face_normals(mesh);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (normals[f] == glm::vec3(0.0f)) continue;
+    const Triangle& t = mesh.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& a = mesh.positions[t[k]];
+      const glm::vec3& b = mesh.positions[t[(k + 1) % 3]];
+      const glm::vec3& c = mesh.positions[t[(k + 2) % 3]];
+      sum[t[k]] += glm::dvec3(normals[f]) * static_cast<double>(corner_angle(a, b, c));
+    }
+  }
+  std::vector<glm::vec3> out(mesh.positions.size(), glm::vec3(0.0f));
+  for (std::size_t v = 0; v < sum.size(); ++v) {
+    const double len = glm::length(sum[v]);
+    if (len > 1e-12) out[v] = glm::vec3(sum[v] / len);
+  }
+  return out;
+}
+
+std::vector<glm::vec3> face_centroids(const Mesh& mesh) {
+  std::vector<glm::vec3> out(mesh.triangles.size(), glm::vec3(0.0f));
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const Triangle& t = mesh.triangles[f];
+    if (!in_range(mesh, t)) continue;
+    out[f] = (mesh.positions[t[0]] + mesh.positions[t[1]] + mesh.positions[t[2]]) / 3.0f;
+  }
+  return out;
+}
+
+void validate_mesh(const Mesh& mesh, const std::string& what) {
+  if (mesh.triangles.empty()) throw InputError(what + ": the mesh has no triangles");
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::vec3& p = mesh.positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw InputError(what + ": vertex " + std::to_string(v) +
+                       " has a non-finite coordinate (NaN or Inf)");
+  }
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (!in_range(mesh, mesh.triangles[f]))
+      throw InputError(what + ": triangle " + std::to_string(f) +
+                       " uses a vertex index out of range (" +
+                       std::to_string(mesh.positions.size()) + " vertices)");
+  }
+}
+
+Mesh transformed(const Mesh& mesh, const float (&m)[16]) {
+  Mesh out = mesh;
+  for (glm::vec3& p : out.positions) {
+    const glm::vec3 q = p;
+    p = glm::vec3(m[0] * q.x + m[4] * q.y + m[8] * q.z + m[12],
+                  m[1] * q.x + m[5] * q.y + m[9] * q.z + m[13],
+                  m[2] * q.x + m[6] * q.y + m[10] * q.z + m[14]);
+  }
+  return out;
+}
+
+}  // namespace sdfkit

@@ -1,0 +1,123 @@
+#include "sdfkit/core/topology.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace sdfkit {
+namespace {
+
+struct EdgeFace {
+  std::uint32_t a, b;  // a < b
+  std::uint32_t face;
+  bool operator<(const EdgeFace& o) const {
+    return a != o.a ? a < o.a : (b != o.b ? b < o.b : face < o.face);
+  }
+};
+
+// All edges of all triangles with their face, sorted by (a, b). Self-edges (a == b) of
+// triangles with repeated indices are skipped.
+std::vector<EdgeFace> sorted_edges(const Mesh& mesh) {
+  std::vector<EdgeFace> edges;
+  edges.reserve(mesh.triangles.size() * 3);
+  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f) {
+    const Triangle& t = mesh.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = t[k], b = t[(k + 1) % 3];
+      if (a == b) continue;
+      if (a > b) std::swap(a, b);
+      edges.push_back({a, b, f});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  return edges;
+}
+
+Adjacency from_pairs(std::size_t n, std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs) {
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  Adjacency adj;
+  adj.offsets.assign(n + 1, 0);
+  for (const auto& [i, j] : pairs) ++adj.offsets[i + 1];
+  std::partial_sum(adj.offsets.begin(), adj.offsets.end(), adj.offsets.begin());
+  adj.indices.resize(pairs.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) adj.indices[k] = pairs[k].second;
+  return adj;
+}
+
+struct UnionFind {
+  std::vector<std::uint32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
+};
+
+}  // namespace
+
+Adjacency vertex_adjacency(const Mesh& mesh) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  pairs.reserve(mesh.triangles.size() * 6);
+  for (const Triangle& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+      if (a == b) continue;
+      pairs.emplace_back(a, b);
+      pairs.emplace_back(b, a);
+    }
+  }
+  return from_pairs(mesh.positions.size(), pairs);
+}
+
+Adjacency face_adjacency(const Mesh& mesh) {
+  const auto edges = sorted_edges(mesh);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
+    for (std::size_t x = i; x < j; ++x)
+      for (std::size_t y = i; y < j; ++y)
+        if (edges[x].face != edges[y].face) pairs.emplace_back(edges[x].face, edges[y].face);
+    i = j;
+  }
+  return from_pairs(mesh.triangles.size(), pairs);
+}
+
+MeshReport analyze(const Mesh& mesh) {
+  MeshReport r;
+  r.vertices = mesh.positions.size();
+  r.faces = mesh.triangles.size();
+  r.bounds = bounding_box(mesh.positions);
+  const auto degenerate = degenerate_faces(mesh);
+  r.degenerate_faces = static_cast<std::size_t>(std::count(degenerate.begin(), degenerate.end(), 1));
+
+  const auto edges = sorted_edges(mesh);
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
+    const std::size_t uses = j - i;
+    if (uses == 1) ++r.boundary_edges;
+    if (uses >= 3) ++r.non_manifold_edges;
+    i = j;
+  }
+
+  UnionFind uf(mesh.positions.size());
+  std::vector<std::uint8_t> used(mesh.positions.size(), 0);
+  for (const Triangle& t : mesh.triangles) {
+    if (t[0] >= r.vertices || t[1] >= r.vertices || t[2] >= r.vertices) continue;
+    uf.unite(t[0], t[1]);
+    uf.unite(t[1], t[2]);
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  }
+  for (std::uint32_t v = 0; v < r.vertices; ++v) {
+    if (!used[v]) {
+      ++r.isolated_vertices;
+    } else if (uf.find(v) == v) {
+      ++r.components;
+    }
+  }
+  return r;
+}
+
+}  // namespace sdfkit

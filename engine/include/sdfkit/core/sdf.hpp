@@ -1,0 +1,87 @@
+#pragma once
+// The SDF pipeline's data: what a backend is asked (SdfQuery), what it answers (RawSdf), and
+// the finished field (SdfField) with filled gaps. A backend sees only a Mesh and a query.
+
+#include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/sdf_definition.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sdfkit {
+
+enum class SdfDomain { Vertex, Face };
+
+struct SdfOptions {
+  int rays = kDefaultRays;                  // rays per point (ray backends)
+  float cone_degrees = kDefaultConeDegrees; // full aperture of the cone, degrees, (0, 180]
+  SdfDomain domain = SdfDomain::Vertex;
+  FalseHitRule false_hit = FalseHitRule::Paper;
+};
+
+// Throws InputError with a sentence when an option is out of range.
+void validate_options(const SdfOptions& options);
+
+// The points to evaluate, each with its outward normal. Points with valid == 0 (isolated
+// vertices, degenerate faces) cast no ray and get filled values.
+struct SdfQuery {
+  SdfDomain domain = SdfDomain::Vertex;
+  std::vector<glm::vec3> origins;         // the surface points (vertices or centroids)
+  std::vector<glm::vec3> normals;         // unit outward normals (zero where invalid)
+  std::vector<std::uint8_t> valid;        // 1 = cast rays from this point
+  float origin_offset = 0.0f;             // kOriginOffset * bounding-box diagonal
+  std::size_t size() const { return origins.size(); }
+};
+
+SdfQuery make_query(const Mesh& mesh, SdfDomain domain);
+
+// A backend's answer: per point, the gathered value and the number of kept rays (0 = no value).
+struct RawSdf {
+  std::vector<float> values;
+  std::vector<std::uint32_t> kept_rays;
+};
+
+// The finished field, in model units, one value per query point.
+struct SdfField {
+  SdfDomain domain = SdfDomain::Vertex;
+  std::vector<float> values;             // finite everywhere
+  std::vector<std::uint32_t> kept_rays;  // 0 where the value was filled
+  std::vector<std::uint8_t> filled;      // 1 where the value was filled
+  std::size_t filled_count = 0;
+};
+
+// Fills points without a value by the mean of their valued neighbours (vertex one-ring or
+// edge-adjacent faces), repeated outward ring by ring until nothing changes; points in parts
+// with no valued point at all get the mean of all valued points, or 0 when nothing has a value.
+SdfField finish_field(const Mesh& mesh, SdfDomain domain, RawSdf raw);
+
+// (v - min) / (max - min) per value; all zeros when max == min.
+std::vector<float> normalized(std::span<const float> values);
+
+// Every backend implements this. A backend object is a session: it keeps its device context,
+// compiled programs and uploaded geometry between calls.
+class SdfBackend {
+public:
+  virtual ~SdfBackend() = default;
+  SdfBackend() = default;
+  SdfBackend(const SdfBackend&) = delete;
+  SdfBackend& operator=(const SdfBackend&) = delete;
+
+  virtual std::string name() const = 0;
+  // Human-readable device description ("llvmpipe (LLVM 15.0.6, 256 bits)", "Embree 3.13 CPU").
+  virtual std::string device_name() const = 0;
+  // Uploads geometry and builds whatever the backend needs; replaces earlier geometry.
+  virtual void set_mesh(const Mesh& mesh) = 0;
+  // Moves the vertices of the current mesh (same count, same triangles) and rebuilds derived
+  // data; cheaper than set_mesh. Throws Error when the count differs.
+  virtual void update_positions(std::span<const glm::vec3> positions) = 0;
+  // Evaluates the query against the current mesh.
+  virtual RawSdf compute(const SdfQuery& query, const SdfOptions& options) = 0;
+};
+
+// Convenience: query, compute, fill. backend.set_mesh(mesh) must have been called.
+SdfField compute_sdf(SdfBackend& backend, const Mesh& mesh, const SdfOptions& options);
+
+}  // namespace sdfkit

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package sdfkit needs to build, test and benchmark.
+# Usage: scripts/install-deps.sh [--bench]   (--bench adds CGAL and MeshLab for comparisons)
+set -euo pipefail
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git python3
+  # Vulkan: loader, headers, lavapipe (CPU driver), validation layers, shader compiler
+  libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslang-tools spirv-tools vulkan-tools
+  # OpenCL: ICD loader, headers, PoCL (CPU platform)
+  ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
+  # geometry and I/O
+  libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libeigen3-dev
+  # reference ray caster (tests and benchmarks only)
+  libembree-dev libtbb-dev
+  # CLI, logging, tests, benchmarks
+  libcli11-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
+  # test data: CGAL's mesh data set (data.tar.gz); headers only used by the bench helper
+  libcgal-demo
+)
+
+if [ "${1:-}" = "--bench" ]; then
+  packages+=(libcgal-dev meshlab xvfb xauth)
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${packages[@]}"

@@ -1,0 +1,124 @@
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/core/topology.hpp"
+#include "sdfkit/core/weld.hpp"
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace sdfkit;
+
+TEST(Normals, BoxFaceNormalsPointOutward) {
+  const Mesh m = shapes::box(2, 2, 2, 3);
+  const auto n = face_normals(m);
+  const auto c = face_centroids(m);
+  for (std::size_t f = 0; f < n.size(); ++f) {
+    EXPECT_NEAR(glm::length(n[f]), 1.0f, 1e-5f);
+    EXPECT_GT(glm::dot(n[f], c[f]), 0.9f);  // centroid on a face at distance 1 from the origin
+  }
+}
+
+TEST(Normals, AngleWeightedVertexNormalIgnoresTriangulation) {
+  // A cube corner: three faces split into different numbers of triangles. The angle-weighted
+  // normal is the diagonal whatever the split.
+  const Mesh m = shapes::box(2, 2, 2, 1);
+  const auto n = vertex_normals(m);
+  for (std::size_t v = 0; v < m.positions.size(); ++v)
+    EXPECT_NEAR(glm::dot(n[v], glm::normalize(m.positions[v])), 1.0f, 1e-5f) << v;
+}
+
+TEST(Normals, DegenerateFacesGiveNoNaN) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}};
+  m.triangles = {{0, 1, 2}, {0, 1, 3}, {3, 3, 3}};
+  const auto deg = degenerate_faces(m);
+  EXPECT_EQ(deg[0], 1);
+  EXPECT_EQ(deg[1], 0);
+  EXPECT_EQ(deg[2], 1);
+  for (const auto& n : face_normals(m)) EXPECT_TRUE(std::isfinite(n.x + n.y + n.z));
+  for (const auto& n : vertex_normals(m)) EXPECT_TRUE(std::isfinite(n.x + n.y + n.z));
+  EXPECT_EQ(face_normals(m)[0], glm::vec3(0.0f));
+  EXPECT_EQ(face_areas(m)[0], 0.0f);
+  EXPECT_NEAR(face_areas(m)[1], 0.5f, 1e-6f);
+}
+
+TEST(Validate, RejectsEmptyOutOfRangeAndNonFinite) {
+  Mesh empty;
+  EXPECT_THROW(validate_mesh(empty, "x"), InputError);
+  Mesh bad;
+  bad.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  bad.triangles = {{0, 1, 3}};
+  EXPECT_THROW(validate_mesh(bad, "x"), InputError);
+  bad.triangles = {{0, 1, 2}};
+  EXPECT_NO_THROW(validate_mesh(bad, "x"));
+  bad.positions[1].y = std::nanf("");
+  EXPECT_THROW(validate_mesh(bad, "x"), InputError);
+  bad.positions[1].y = INFINITY;
+  EXPECT_THROW(validate_mesh(bad, "x"), InputError);
+}
+
+TEST(Weld, MergesEqualPositionsAndKeepsTriangleOrder) {
+  // Two triangles of a quad, each with its own copies of the shared corners (a glTF seam).
+  const glm::vec3 p[] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const Triangle t[] = {{0, 1, 2}, {3, 4, 5}};
+  const WeldResult w = weld(p, t);
+  EXPECT_EQ(w.mesh.positions.size(), 4u);
+  ASSERT_EQ(w.mesh.triangles.size(), 2u);
+  EXPECT_EQ(w.input_to_welded[3], w.input_to_welded[0]);
+  EXPECT_EQ(w.input_to_welded[4], w.input_to_welded[2]);
+  EXPECT_EQ(analyze(w.mesh).boundary_edges, 4u);
+}
+
+TEST(Weld, ToleranceMergesNearbyPoints) {
+  const glm::vec3 p[] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1e-4f, 0, 0}, {5, 5, 5}};
+  const Triangle t[] = {{0, 1, 2}};
+  EXPECT_EQ(weld(p, t, 0.0f).mesh.positions.size(), 5u);
+  const WeldResult w = weld(p, t, 1e-3f);
+  EXPECT_EQ(w.mesh.positions.size(), 4u);
+  EXPECT_EQ(w.input_to_welded[3], w.input_to_welded[0]);
+}
+
+TEST(Weld, NegativeZeroWeldsWithZero) {
+  const glm::vec3 p[] = {{0, 0, 0}, {-0.0f, 0, 0}};
+  EXPECT_EQ(weld(p, {}).mesh.positions.size(), 1u);
+}
+
+TEST(Topology, ClosedShapesHaveNoBoundary) {
+  for (const Mesh& m : {shapes::sphere(1, 16, 8), shapes::torus(2, 0.5f, 24, 12),
+                        shapes::box(1, 2, 3, 4), shapes::capped_cylinder(1, 3, 16, 4, 2),
+                        shapes::icosphere(1, 2)}) {
+    const MeshReport r = analyze(m);
+    EXPECT_EQ(r.boundary_edges, 0u);
+    EXPECT_EQ(r.non_manifold_edges, 0u);
+    EXPECT_EQ(r.components, 1u);
+    EXPECT_EQ(r.degenerate_faces, 0u);
+  }
+}
+
+TEST(Topology, CountsBoundaryNonManifoldComponentsAndIsolated) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, -1, 0}, {9, 9, 9},
+                 {5, 0, 0}, {6, 0, 0}, {5, 1, 0}};
+  // Three triangles on edge (0, 1): non-manifold; a separate triangle; vertex 5 unused.
+  m.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {6, 7, 8}};
+  const MeshReport r = analyze(m);
+  EXPECT_EQ(r.non_manifold_edges, 1u);
+  EXPECT_EQ(r.components, 2u);
+  EXPECT_EQ(r.isolated_vertices, 1u);
+  EXPECT_EQ(r.boundary_edges, 6u + 3u);
+}
+
+TEST(Topology, AdjacencyOfATetrahedron) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  const Adjacency v = vertex_adjacency(m);
+  const Adjacency f = face_adjacency(m);
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(v.offsets[i + 1] - v.offsets[i], 3u);
+    EXPECT_EQ(f.offsets[i + 1] - f.offsets[i], 3u);
+  }
+}
