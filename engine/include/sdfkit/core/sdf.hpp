@@ -60,6 +60,12 @@ SdfField finish_field(const Mesh& mesh, SdfDomain domain, RawSdf raw);
 // (v - min) / (max - min) per value; all zeros when max == min.
 std::vector<float> normalized(std::span<const float> values);
 
+// One stage of a backend's last compute() or set_mesh(), for benchmarks and --profile.
+struct StageTiming {
+  std::string stage;  // "octree_build", "upload", "trace_gather", "peel", ...
+  double milliseconds = 0.0;
+};
+
 // Every backend implements this. A backend object is a session: it keeps its device context,
 // compiled programs and uploaded geometry between calls.
 class SdfBackend {
@@ -79,6 +85,10 @@ public:
   virtual void update_positions(std::span<const glm::vec3> positions) = 0;
   // Evaluates the query against the current mesh.
   virtual RawSdf compute(const SdfQuery& query, const SdfOptions& options) = 0;
+  // Wall-clock time of the stages of the last set_mesh/update_positions/compute calls.
+  virtual std::vector<StageTiming> last_timings() const { return {}; }
+  // Peak device memory the backend held during the last compute(), in bytes (0 = unknown).
+  virtual std::size_t device_memory_bytes() const { return 0; }
 };
 
 // Convenience: query, compute, fill. backend.set_mesh(mesh) must have been called.
