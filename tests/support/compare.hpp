@@ -1,6 +1,6 @@
 #pragma once
-// Statistics for comparing two per-point fields (backend against reference, rotated against
-// unrotated).
+// Test-side names for the engine's field comparison (sdfkit/post/compare.hpp), kept so tests
+// read as assertions: backend against reference, rotated against unrotated.
 
 #include <span>
 

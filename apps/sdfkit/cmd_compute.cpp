@@ -1,0 +1,89 @@
+#include "commands.hpp"
+
+#include "sdfkit/core/error.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+namespace sdfkit::cli {
+
+void add_sdf_options(CLI::App& cmd, SdfCliOptions& o) {
+  cmd.add_option("--backend", o.backend, "auto | vulkan | opencl (auto: Vulkan when a device exists)")
+      ->check(CLI::IsMember({"auto", "vulkan", "opencl"}, CLI::ignore_case));
+  cmd.add_option("--device", o.backend_config.device,
+                 "Device index or name substring (default: env SDFKIT_VK_DEVICE / SDFKIT_CL_DEVICE)");
+  cmd.add_option("--per", o.per, "vertex | face")->check(CLI::IsMember({"vertex", "face"}));
+  cmd.add_option("--rays", o.sdf.rays, "Rays per point (ray casting)")->check(CLI::Range(1, 1024));
+  cmd.add_option("--cone", o.sdf.cone_degrees, "Full cone aperture in degrees")->check(CLI::Range(1.0, 180.0));
+  cmd.add_option("--false-hits", o.false_hits,
+                 "paper: drop hits facing the start normal | cgal: keep hits where the ray leaves the solid")
+      ->check(CLI::IsMember({"paper", "cgal"}));
+  cmd.add_option("--views", o.backend_config.views, "Camera directions (Vulkan depth peeling)")
+      ->check(CLI::Range(1, 4096));
+  cmd.add_option("--resolution", o.backend_config.resolution, "Framebuffer size in pixels (Vulkan)")
+      ->check(CLI::Range(16, 8192));
+  cmd.add_option("--memory-cap", o.backend_config.memory_cap, "Device memory cap in bytes (OpenCL)");
+  cmd.add_flag("--profile", o.backend_config.profile, "Time each pass on the device");
+  cmd.add_option("--smooth", o.smooth, "k-ring Gaussian smoothing of the result (rings, 0 = off)")
+      ->check(CLI::Range(0, 64));
+  cmd.add_flag("--normalize", o.write.normalized, "Write values normalised to [0, 1]");
+  cmd.add_flag("--no-color", o.no_color, "Do not write COLOR_0 / PLY colours");
+  cmd.add_option("--weld-tolerance", o.load.weld_tolerance, "Weld positions closer than this (model units)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+void finish_sdf_options(SdfCliOptions& o) {
+  o.sdf.domain = o.per == "face" ? SdfDomain::Face : SdfDomain::Vertex;
+  o.sdf.false_hit = o.false_hits == "cgal" ? FalseHitRule::Cgal : FalseHitRule::Paper;
+  o.backend_config.kind = parse_backend_kind(o.backend);
+  o.write.color = !o.no_color;
+  validate_options(o.sdf);
+}
+
+void add_compute_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("compute", "Compute the SDF of a mesh and write it");
+  struct Args {
+    std::string input, output, json;
+    bool quiet = false;
+    SdfCliOptions sdf;
+  };
+  auto a = std::make_shared<Args>();
+  cmd->add_option("MESH", a->input, "Mesh file (.gltf .glb .obj .off .ply) or builtin:NAME")->required();
+  cmd->add_option("-o,--output", a->output, "Output file: .glb .gltf (_SDF attribute), .ply (quality), .txt")
+      ->required();
+  cmd->add_option("--json", a->json, "Also write a JSON report of the run to this file");
+  cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
+  add_sdf_options(*cmd, a->sdf);
+  cmd->callback([a] {
+    finish_sdf_options(a->sdf);
+    ComputeRequest req;
+    req.input = a->input;
+    req.output = a->output;
+    req.load = a->sdf.load;
+    req.sdf = a->sdf.sdf;
+    req.write = a->sdf.write;
+    req.smooth_rings = a->sdf.smooth;
+    std::unique_ptr<SdfBackend> backend = make_backend(a->sdf.backend_config);
+    const ComputeReport r = run_compute(req, *backend);
+    if (!a->json.empty()) {
+      const std::string text = report_to_json(r);
+      io::write_file_atomically(a->json, [&](std::ostream& os) { os << text << '\n'; });
+    }
+    if (a->quiet) return;
+    std::printf("%s: %zu vertices, %zu faces (%zu welded vertices) -> %s\n", r.input.c_str(),
+                r.input_vertices, r.input_faces, r.welded_vertices, r.output.c_str());
+    std::printf("backend %s on %s\n", r.backend.c_str(), r.device.c_str());
+    double total = 0;
+    for (const StageTiming& s : r.stages) {
+      std::printf("  %-16s %10.1f ms\n", s.stage.c_str(), s.milliseconds);
+      total += s.milliseconds;
+    }
+    std::printf("  %-16s %10.1f ms\n", "total", total);
+    std::printf("SDF min %g  median %g  mean %g  max %g (model units); %zu of %zu points filled\n",
+                r.summary.min, r.summary.median, r.summary.mean, r.summary.max, r.filled_points, r.points);
+    for (const std::string& w : r.warnings) std::fprintf(stderr, "sdfkit: warning: %s\n", w.c_str());
+  });
+}
+
+}  // namespace sdfkit::cli

@@ -1,0 +1,61 @@
+#include "commands.hpp"
+
+#include "sdfkit/core/topology.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <memory>
+
+namespace sdfkit::cli {
+
+void add_info_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("info", "Print counts and topology of a mesh");
+  auto path = std::make_shared<std::string>();
+  auto json = std::make_shared<bool>(false);
+  auto tolerance = std::make_shared<float>(0.0f);
+  cmd->add_option("MESH", *path, "Mesh file (.gltf .glb .obj .off .ply) or builtin:NAME")->required();
+  cmd->add_option("--weld-tolerance", *tolerance, "Weld positions closer than this (model units)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--json", *json, "Print JSON instead of text");
+  cmd->callback([=] {
+    io::LoadOptions load;
+    load.weld_tolerance = *tolerance;
+    const io::Asset asset = load_input(*path, load);
+    const MeshReport r = analyze(asset.mesh);
+    if (*json) {
+      nlohmann::json j = {
+          {"file", asset.path},
+          {"vertices", asset.input_positions.size()},
+          {"faces", asset.input_triangles.size()},
+          {"welded_vertices", asset.mesh.positions.size()},
+          {"bounds", {{"min", {r.bounds.min.x, r.bounds.min.y, r.bounds.min.z}},
+                      {"max", {r.bounds.max.x, r.bounds.max.y, r.bounds.max.z}}}},
+          {"diagonal", r.bounds.diagonal()},
+          {"components", r.components},
+          {"boundary_edges", r.boundary_edges},
+          {"non_manifold_edges", r.non_manifold_edges},
+          {"degenerate_faces", r.degenerate_faces},
+          {"isolated_vertices", r.isolated_vertices},
+          {"closed", r.boundary_edges == 0 && r.non_manifold_edges == 0},
+          {"warnings", asset.warnings}};
+      std::printf("%s\n", j.dump(2).c_str());
+      return;
+    }
+    std::printf("file:               %s\n", asset.path.c_str());
+    std::printf("vertices:           %zu\n", asset.input_positions.size());
+    std::printf("faces:              %zu\n", asset.input_triangles.size());
+    std::printf("welded vertices:    %zu\n", asset.mesh.positions.size());
+    std::printf("bounding box:       [%g, %g, %g] .. [%g, %g, %g] (diagonal %g)\n", r.bounds.min.x,
+                r.bounds.min.y, r.bounds.min.z, r.bounds.max.x, r.bounds.max.y, r.bounds.max.z,
+                r.bounds.diagonal());
+    std::printf("components:         %zu\n", r.components);
+    std::printf("boundary edges:     %zu%s\n", r.boundary_edges, r.boundary_edges ? " (open mesh)" : "");
+    std::printf("non-manifold edges: %zu\n", r.non_manifold_edges);
+    std::printf("degenerate faces:   %zu\n", r.degenerate_faces);
+    std::printf("isolated vertices:  %zu\n", r.isolated_vertices);
+    for (const std::string& w : asset.warnings) std::printf("warning:            %s\n", w.c_str());
+  });
+}
+
+}  // namespace sdfkit::cli

@@ -1,0 +1,32 @@
+#include "commands.hpp"
+
+#include <nlohmann/json.hpp>
+
+namespace sdfkit::cli {
+
+std::string report_to_json(const ComputeReport& r, const std::string& error) {
+  nlohmann::json stages = nlohmann::json::object();
+  double total = 0;
+  for (const StageTiming& s : r.stages) {
+    stages[s.stage] = s.milliseconds;
+    total += s.milliseconds;
+  }
+  nlohmann::json j = {
+      {"input", r.input},
+      {"output", r.output},
+      {"ok", error.empty()},
+      {"error", error.empty() ? nlohmann::json(nullptr) : nlohmann::json(error)},
+      {"counts",
+       {{"input_vertices", r.input_vertices}, {"input_faces", r.input_faces},
+        {"welded_vertices", r.welded_vertices}, {"points", r.points}, {"filled_points", r.filled_points}}},
+      {"backend", r.backend},
+      {"device", r.device},
+      {"time_ms", stages},
+      {"total_ms", total},
+      {"summary",
+       {{"min", r.summary.min}, {"median", r.summary.median}, {"mean", r.summary.mean}, {"max", r.summary.max}}},
+      {"warnings", r.warnings}};
+  return j.dump(2);
+}
+
+}  // namespace sdfkit::cli

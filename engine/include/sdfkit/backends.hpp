@@ -1,0 +1,47 @@
+#pragma once
+// Choosing and creating an SDF backend by name: what the CLI, batch jobs and embedding tools use.
+// The Embree reference is not here: it is for tests and benchmarks only.
+
+#include "sdfkit/core/sdf.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sdfkit {
+
+enum class BackendKind { Auto, Vulkan, OpenCL };
+
+// "auto", "vulkan", "opencl" (case-insensitive); throws InputError otherwise.
+BackendKind parse_backend_kind(const std::string& name);
+const char* to_string(BackendKind kind);
+
+struct BackendConfig {
+  BackendKind kind = BackendKind::Auto;  // Auto: Vulkan when a suitable device exists, else OpenCL
+  std::string device;                    // device selector (index or name substring); "" = env/auto
+  // Vulkan depth peeling
+  int views = 0;                         // 0 = the backend's default
+  int resolution = 0;                    // 0 = the backend's default
+  bool validation = false;
+  bool profile = false;
+  // OpenCL ray casting
+  std::size_t memory_cap = 0;            // bytes; 0 = the backend's default
+};
+
+// Creates a backend session. Throws DeviceError when the requested backend is not built in or
+// has no usable device; with Auto, says why each backend was unavailable.
+std::unique_ptr<SdfBackend> make_backend(const BackendConfig& config);
+
+// Which backends this build contains.
+std::vector<BackendKind> built_backends();
+
+// One line per device of every built backend, for `sdfkit devices`.
+struct DeviceListing {
+  std::string backend;  // "vulkan" / "opencl"
+  std::string description;
+  bool usable = true;
+  std::string reason;   // why unusable
+};
+std::vector<DeviceListing> list_all_devices();
+
+}  // namespace sdfkit

@@ -1,0 +1,123 @@
+#include "sdfkit/pipeline.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/core/weld.hpp"
+#include "sdfkit/post/smooth.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace sdfkit {
+namespace {
+
+class Stopwatch {
+public:
+  double lap_ms() {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+std::string builtin_names() { return "sphere, torus, capsule, slab, tube (the paper's Figure 7 model)"; }
+
+io::Asset load_input(const std::string& path, const io::LoadOptions& options) {
+  static const std::string prefix = "builtin:";
+  if (path.rfind(prefix, 0) != 0) return io::load_asset(path, options);
+  const std::string name = path.substr(prefix.size());
+  Mesh mesh;
+  if (name == "sphere") mesh = shapes::icosphere(1.0f, 4);
+  else if (name == "torus") mesh = shapes::torus(2.0f, 0.6f, 96, 48);
+  else if (name == "capsule") mesh = shapes::capsule(0.5f, 3.0f, 64, 24);
+  else if (name == "slab") mesh = shapes::box(10.0f, 10.0f, 1.0f, 20);
+  else if (name == "tube") mesh = shapes::swept_tube().mesh;
+  else throw InputError(path + ": unknown built-in shape (available: " + builtin_names() + ")");
+  io::Asset asset;
+  asset.path = path;
+  asset.format = io::Format::Off;
+  asset.input_positions = mesh.positions;
+  asset.input_triangles = mesh.triangles;
+  WeldResult welded = weld(mesh.positions, mesh.triangles, options.weld_tolerance);
+  asset.mesh = std::move(welded.mesh);
+  asset.input_to_welded = std::move(welded.input_to_welded);
+  return asset;
+}
+
+FieldSummary summarize(std::span<const float> values) {
+  FieldSummary s;
+  if (values.empty()) return s;
+  const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  s.min = *lo;
+  s.max = *hi;
+  double sum = 0.0;
+  for (float v : values) sum += v;
+  s.mean = static_cast<float>(sum / static_cast<double>(values.size()));
+  s.median = median_of(values);
+  return s;
+}
+
+ComputeReport run_compute(const ComputeRequest& request, SdfBackend& backend) {
+  validate_options(request.sdf);
+  ComputeReport report;
+  report.input = request.input;
+  report.output = request.output;
+  report.backend = backend.name();
+  report.device = backend.device_name();
+  Stopwatch clock;
+
+  // Fail on an unwritable output before spending the compute time.
+  if (!request.output.empty()) {
+    const io::Format out = io::format_from_path(request.output);
+    if (request.sdf.domain == SdfDomain::Face && (out == io::Format::Gltf || out == io::Format::Glb))
+      throw InputError(request.output + ": per-face values cannot be stored in glTF; write .ply or .txt");
+  }
+
+  io::Asset asset = load_input(request.input, request.load);
+  report.stages.push_back({"load", clock.lap_ms()});
+  report.input_vertices = asset.input_positions.size();
+  report.input_faces = asset.input_triangles.size();
+  report.welded_vertices = asset.mesh.positions.size();
+  report.warnings = asset.warnings;
+
+  backend.set_mesh(asset.mesh);
+  const double set_mesh_ms = clock.lap_ms();
+  SdfField field = compute_sdf(backend, asset.mesh, request.sdf);
+  const double compute_ms = clock.lap_ms();
+  const auto backend_stages = backend.last_timings();
+  if (backend_stages.empty()) {
+    report.stages.push_back({"prepare", set_mesh_ms});
+    report.stages.push_back({"sdf", compute_ms});
+  } else {
+    for (const StageTiming& s : backend_stages) report.stages.push_back(s);
+  }
+  report.points = field.values.size();
+  report.filled_points = field.filled_count;
+  if (field.filled_count > 0)
+    report.warnings.push_back(std::to_string(field.filled_count) + " of " +
+                              std::to_string(field.values.size()) +
+                              " points had no accepted ray and were filled from their neighbours");
+
+  if (request.smooth_rings > 0) {
+    SmoothOptions smooth;
+    smooth.rings = request.smooth_rings;
+    field.values = smooth_field(asset.mesh, field.domain, field.values, smooth);
+    report.stages.push_back({"smooth", clock.lap_ms()});
+  }
+  report.summary = summarize(field.values);
+
+  if (!request.output.empty()) {
+    io::write_field(request.output, asset, field, request.write);
+    report.stages.push_back({"write", clock.lap_ms()});
+  }
+  return report;
+}
+
+}  // namespace sdfkit

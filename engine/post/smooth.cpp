@@ -1,0 +1,91 @@
+#include "sdfkit/post/smooth.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/topology.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <thread>
+
+namespace sdfkit {
+
+float mean_edge_length(const Mesh& mesh) {
+  const Adjacency adj = vertex_adjacency(mesh);
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (std::uint32_t i = 0; i < adj.size(); ++i)
+    for (std::uint32_t k = adj.offsets[i]; k < adj.offsets[i + 1]; ++k) {
+      const std::uint32_t j = adj.indices[k];
+      if (j <= i) continue;
+      sum += glm::length(mesh.positions[i] - mesh.positions[j]);
+      ++count;
+    }
+  return count ? static_cast<float>(sum / static_cast<double>(count)) : 0.0f;
+}
+
+std::vector<float> smooth_field(const Mesh& mesh, SdfDomain domain, std::span<const float> values,
+                                const SmoothOptions& options) {
+  if (options.rings < 1 || options.rings > 64)
+    throw InputError("--smooth must be between 1 and 64 rings, got " + std::to_string(options.rings));
+  const bool per_vertex = domain == SdfDomain::Vertex;
+  const std::size_t n = per_vertex ? mesh.positions.size() : mesh.triangles.size();
+  if (values.size() != n)
+    throw Error("smoothing: " + std::to_string(values.size()) + " values for " + std::to_string(n) +
+                (per_vertex ? " vertices" : " faces"));
+  const Adjacency adj = per_vertex ? vertex_adjacency(mesh) : face_adjacency(mesh);
+  const std::vector<glm::vec3> points = per_vertex ? mesh.positions : face_centroids(mesh);
+  float sigma = options.sigma;
+  if (!(sigma > 0.0f)) sigma = 0.5f * static_cast<float>(options.rings) * mean_edge_length(mesh);
+  std::vector<float> out(values.begin(), values.end());
+  if (!(sigma > 0.0f) || n == 0) return out;
+  const float inv_two_sigma2 = 1.0f / (2.0f * sigma * sigma);
+
+  unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
+                                         : std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 4096)));
+
+  auto work = [&](std::size_t begin, std::size_t end) {
+    // Breadth-first rings with a visit stamp per point: no clearing between points.
+    std::vector<std::uint32_t> stamp(n, UINT32_MAX);
+    std::vector<std::uint32_t> ring, next;
+    for (std::size_t i = begin; i < end; ++i) {
+      const auto self = static_cast<std::uint32_t>(i);
+      stamp[i] = self;
+      ring.assign(1, self);
+      double wsum = 1.0, vsum = values[i];
+      for (int r = 0; r < options.rings && !ring.empty(); ++r) {
+        next.clear();
+        for (std::uint32_t p : ring)
+          for (std::uint32_t k = adj.offsets[p]; k < adj.offsets[p + 1]; ++k) {
+            const std::uint32_t q = adj.indices[k];
+            if (stamp[q] == self) continue;
+            stamp[q] = self;
+            next.push_back(q);
+            const glm::vec3 d = points[q] - points[i];
+            const float w = std::exp(-glm::dot(d, d) * inv_two_sigma2);
+            wsum += w;
+            vsum += static_cast<double>(w) * values[q];
+          }
+        ring.swap(next);
+      }
+      out[i] = static_cast<float>(vsum / wsum);
+    }
+  };
+  if (threads <= 1) {
+    work(0, n);
+  } else {
+    std::vector<std::thread> pool;
+    const std::size_t chunk = (n + threads - 1) / threads;
+    for (unsigned t = 0; t < threads; ++t) {
+      const std::size_t b = t * chunk, e = std::min(n, b + chunk);
+      if (b < e) pool.emplace_back(work, b, e);
+    }
+    for (auto& th : pool) th.join();
+  }
+  return out;
+}
+
+}  // namespace sdfkit

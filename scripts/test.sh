@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs dependencies, builds with warnings as errors, and runs the whole test suite with
+# CTest: Vulkan on Mesa lavapipe, OpenCL on PoCL (CPU devices: no GPU needed). A missing
+# device fails the device tests. Then a sanitizer build (ASan + UBSan) runs the CPU tests.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+
+# Pin the CPU drivers so results do not depend on whatever GPU the machine has.
+export VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
+export VK_ICD_FILENAMES="$VK_DRIVER_FILES"
+export SDFKIT_VK_VALIDATION=1
+export OCL_ICD_VENDORS=/etc/OpenCL/vendors
+export POCL_CACHE_DIR="${TMPDIR:-/tmp}/sdfkit-pocl-cache"
+unset SDFKIT_ALLOW_NO_DEVICE
+
+scripts/build.sh
+ctest --test-dir build --output-on-failure -j2 --timeout 600
+
+if [ "${SDFKIT_SKIP_SANITIZE:-0}" != "1" ]; then
+  SDFKIT_BUILD_DIR=build-asan scripts/build.sh -DSDFKIT_SANITIZE=ON -DSDFKIT_WITH_VULKAN=OFF \
+    -DSDFKIT_WITH_OPENCL=OFF -DSDFKIT_BUILD_BENCH=OFF
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    ctest --test-dir build-asan --output-on-failure -j2 -L 'core|reference|skeleton' --timeout 600
+fi

@@ -1,0 +1,151 @@
+// Runs the real `sdfkit` binary on real and broken files: every bad input must give exactly one
+// error line naming the file and a non-zero exit, never a crash, and never a written output.
+#include "analytic.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int exit_code = -1;
+  bool signaled = false;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("sdfkit_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Run run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(SDFKIT_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    Run r;
+    r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+  fs::path write(const std::string& name, const std::string& content) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << content;
+    return p;
+  }
+  // One line on stderr, "sdfkit: error: ..." naming `what`, exit code 1.
+  void expect_clean_error(const Run& r, const std::string& what) {
+    EXPECT_FALSE(r.signaled) << r.err;
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("sdfkit: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+  }
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(Cli, Version) {
+  const Run r = run("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("sdfkit "), std::string::npos);
+}
+
+TEST_F(Cli, InfoOnARealMesh) {
+  const Run r = run("info " + sdfkit::test::data_mesh("cow.off"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("vertices:           2904"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("faces:              5804"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("boundary edges:     0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("components:         1"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, InfoReportsAnOpenMesh) {
+  const Run r = run("info " + sdfkit::test::data_mesh("cube-ouvert.off") + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"closed\": false"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, InfoOnBuiltinShape) {
+  const Run r = run("info builtin:torus");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("boundary edges:     0"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, MissingFile) { expect_clean_error(run("info " + (dir_ / "nope.off").string()), "nope.off"); }
+
+TEST_F(Cli, UnknownExtension) {
+  const fs::path p = write("mesh.xyz", "hello");
+  expect_clean_error(run("info " + p.string()), "mesh.xyz");
+}
+
+TEST_F(Cli, TruncatedOff) {
+  const fs::path p = write("t.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n");
+  expect_clean_error(run("info " + p.string()), "t.off");
+}
+
+TEST_F(Cli, NaNCoordinates) {
+  const fs::path p = write("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n");
+  expect_clean_error(run("info " + p.string()), "nan.off");
+}
+
+TEST_F(Cli, IndexOutOfRange) {
+  const fs::path p = write("idx.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
+  expect_clean_error(run("info " + p.string()), "idx.obj");
+}
+
+TEST_F(Cli, EmptyMesh) {
+  const fs::path p = write("empty.off", "OFF\n0 0 0\n");
+  expect_clean_error(run("info " + p.string()), "empty.off");
+}
+
+TEST_F(Cli, MalformedGlb) {
+  const fs::path p = write("bad.glb", std::string("glTF\x02\x00\x00\x00garbage", 16));
+  expect_clean_error(run("info " + p.string()), "bad.glb");
+}
+
+TEST_F(Cli, MalformedPly) {
+  const fs::path p = write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
+  expect_clean_error(run("info " + p.string()), "bad.ply");
+}
+
+TEST_F(Cli, FailedComputeWritesNothingAndKeepsAnExistingFile) {
+  const fs::path bad = write("bad.off", "OFF\n3 1 0\n0 0 0\n");
+  const fs::path out = write("result.txt", "previous result\n");
+  expect_clean_error(run("compute " + bad.string() + " -o " + out.string()), "bad.off");
+  EXPECT_EQ(slurp(out), "previous result\n");
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++files;
+  EXPECT_EQ(files, 4);  // bad.off, result.txt, stdout.txt, stderr.txt: no temporary left over
+}
+
+TEST_F(Cli, BadOptionValuesAreUsageErrors) {
+  const Run r = run("compute builtin:sphere -o x.txt --rays 0");
+  EXPECT_FALSE(r.signaled);
+  EXPECT_NE(r.exit_code, 0);
+}
+
+TEST_F(Cli, UnknownBuiltin) { expect_clean_error(run("info builtin:teapot"), "builtin:teapot"); }
