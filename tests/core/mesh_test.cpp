@@ -122,3 +122,18 @@ TEST(Topology, AdjacencyOfATetrahedron) {
     EXPECT_EQ(f.offsets[i + 1] - f.offsets[i], 3u);
   }
 }
+
+TEST(Subdivide, QuadruplesFacesKeepsTheSurfaceAndStaysClosed) {
+  const Mesh m = shapes::icosphere(1, 2);
+  const Mesh s = subdivide_midpoint(m);
+  EXPECT_EQ(s.triangles.size(), 4 * m.triangles.size());
+  const MeshReport r = analyze(m), rs = analyze(s);
+  // V' = V + E, and E = 3F/2 on a closed triangle mesh.
+  EXPECT_EQ(s.positions.size(), m.positions.size() + 3 * m.triangles.size() / 2);
+  EXPECT_EQ(rs.boundary_edges, 0u);
+  EXPECT_EQ(rs.components, r.components);
+  double area = 0, area_s = 0;
+  for (float a : face_areas(m)) area += a;
+  for (float a : face_areas(s)) area_s += a;
+  EXPECT_NEAR(area_s, area, 1e-4 * area);
+}

@@ -67,3 +67,12 @@ void validate_mesh(const Mesh& mesh, const std::string& what);
 Mesh transformed(const Mesh& mesh, const float (&m)[16]);
 
 }  // namespace sdfkit
+
+namespace sdfkit {
+
+// One step of midpoint subdivision: every triangle becomes four, new vertices at edge midpoints
+// (shared between the two faces of an edge). The surface does not move, so SDF values stay the
+// same while the mesh grows about four times: benchmark meshes at paper sizes.
+Mesh subdivide_midpoint(const Mesh& mesh);
+
+}  // namespace sdfkit

@@ -1,0 +1,104 @@
+// sdfkit-bench: the paper's Table 1 on this machine. Times the Vulkan and OpenCL backends, the
+// Embree reference, CGAL's sdf_values and (with --meshlab) MeshLab's GPU SDF filter on the same
+// meshes in one run; writes Markdown and JSON.
+#include "bench_runner.hpp"
+
+#include "sdfkit/io/asset.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace sdfkit::bench;
+
+namespace {
+
+std::string cpu_name() {
+  std::ifstream f("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown CPU";
+}
+
+std::string self_dir() {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return ".";
+  buf[n] = 0;
+  return fs::path(buf).parent_path().string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"sdfkit-bench: time the SDF backends against the Embree reference, CGAL and MeshLab"};
+  BenchOptions o;
+  std::vector<std::string> meshes;
+  std::string json_out, md_out, work = "bench-work";
+  bool large = false, no_cgal = false;
+  app.add_option("MESHES", meshes, "Meshes to time (default: CGAL's elephant, armadillo, bunny00, refined_elephant)");
+  app.add_option("--backends", o.backends, "Backends: vulkan opencl embree")->delimiter(',');
+  app.add_option("--rays", o.rays, "Rays per point for the ray backends");
+  app.add_option("--views", o.views, "Vulkan views (0 = default)");
+  app.add_option("--resolution", o.resolution, "Vulkan resolution (0 = default)");
+  app.add_option("--repeats", o.repeats, "Warm repeats per backend");
+  app.add_option("--device", o.device, "GPU device selector");
+  app.add_flag("--large", large, "Add bunny00 subdivided (~150k vertices) and armadillo subdivided twice (~416k)");
+  app.add_flag("--meshlab", o.meshlab, "Also time MeshLab's GPU SDF filter (meshlabserver, xvfb-run)");
+  app.add_flag("--no-cgal", no_cgal, "Skip CGAL's sdf_values");
+  app.add_option("--smooth", o.smooth_rings, "k of the k-ring smoothing timing (0 = off)");
+  app.add_option("--work-dir", work, "Where meshes and temporary files go");
+  app.add_option("--json", json_out, "Write results as JSON");
+  app.add_option("--markdown", md_out, "Write the Markdown table");
+  CLI11_PARSE(app, argc, argv);
+  o.cgal = !no_cgal;
+  o.cgal_helper = self_dir() + "/sdfkit-cgal-sdf";
+  if (o.cgal && !fs::exists(o.cgal_helper)) {
+    std::fprintf(stderr, "sdfkit-bench: CGAL helper not built (install libcgal-dev: scripts/install-deps.sh --bench); skipping CGAL\n");
+    o.cgal = false;
+  }
+
+  try {
+    fs::create_directories(work);
+    std::vector<BenchMesh> list;
+    if (meshes.empty())
+      list = default_meshes(work, large);
+    else
+      for (const auto& m : meshes) list.push_back(load_mesh(m, work));
+
+    std::vector<MeshResult> results;
+    for (const BenchMesh& m : list) {
+      std::fprintf(stderr, "sdfkit-bench: %s (%zu vertices, %zu faces)\n", m.name.c_str(), m.mesh.positions.size(),
+                   m.mesh.triangles.size());
+      results.push_back(run_mesh(m, o));
+    }
+    std::ostringstream header;
+    header << "Machine: " << cpu_name() << ", " << std::thread::hardware_concurrency() << " hardware threads";
+    for (const auto& r : results)
+      for (const auto& b : r.runs)
+        if (b.error.empty() && b.backend != "embree") {
+          header << "; " << b.backend << " on " << b.device;
+          break;
+        }
+    header << ".\n\n";
+    const std::string md = header.str() + to_markdown(results, o);
+    std::printf("%s", md.c_str());
+    if (!md_out.empty()) sdfkit::io::write_file_atomically(md_out, [&](std::ostream& os) { os << md; });
+    if (!json_out.empty()) {
+      auto j = to_json(results, o);
+      j["machine"] = header.str();
+      sdfkit::io::write_file_atomically(json_out, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sdfkit-bench: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
