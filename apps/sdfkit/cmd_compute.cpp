@@ -67,7 +67,7 @@ void add_compute_command(CLI::App& app) {
     std::unique_ptr<SdfBackend> backend = make_backend(a->sdf.backend_config);
     const ComputeReport r = run_compute(req, *backend);
     if (!a->json.empty()) {
-      const std::string text = report_to_json(r);
+      const std::string text = report_to_json(r);  // sdfkit::report_to_json
       io::write_file_atomically(a->json, [&](std::ostream& os) { os << text << '\n'; });
     }
     if (a->quiet) return;

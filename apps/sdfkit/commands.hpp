@@ -12,6 +12,7 @@ namespace sdfkit::cli {
 void add_info_command(CLI::App& app);
 void add_compute_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
+void add_batch_command(CLI::App& app);
 
 // The options every SDF-computing command shares (compute, batch, skeleton, render).
 struct SdfCliOptions {
@@ -28,8 +29,5 @@ struct SdfCliOptions {
 void add_sdf_options(CLI::App& cmd, SdfCliOptions& o);
 // Resolves the parsed strings into o.sdf / o.backend_config / o.write (throws InputError).
 void finish_sdf_options(SdfCliOptions& o);
-
-// JSON text of a compute report (the per-asset record of `compute --json` and `batch`).
-std::string report_to_json(const ComputeReport& report, const std::string& error = {});
 
 }  // namespace sdfkit::cli

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   sdfkit::cli::add_info_command(app);
   sdfkit::cli::add_compute_command(app);
   sdfkit::cli::add_devices_command(app);
+  sdfkit::cli::add_batch_command(app);
 
   try {
     app.parse(argc, argv);

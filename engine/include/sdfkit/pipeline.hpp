@@ -40,6 +40,11 @@ struct ComputeReport {
   std::vector<std::string> warnings;
 };
 
+// JSON text of a report: the record of `compute --json` and of each `batch` asset. `error`
+// non-empty marks a failed job; `fingerprint` identifies the options and input it was made with.
+std::string report_to_json(const ComputeReport& report, const std::string& error = {},
+                           const std::string& fingerprint = {});
+
 // Runs one job on an existing backend session (reused across jobs). Throws Error on failure;
 // nothing is written unless everything before the write succeeded.
 ComputeReport run_compute(const ComputeRequest& request, SdfBackend& backend);

@@ -1,10 +1,10 @@
-#include "commands.hpp"
+#include "sdfkit/pipeline.hpp"
 
 #include <nlohmann/json.hpp>
 
-namespace sdfkit::cli {
+namespace sdfkit {
 
-std::string report_to_json(const ComputeReport& r, const std::string& error) {
+std::string report_to_json(const ComputeReport& r, const std::string& error, const std::string& fingerprint) {
   nlohmann::json stages = nlohmann::json::object();
   double total = 0;
   for (const StageTiming& s : r.stages) {
@@ -25,8 +25,9 @@ std::string report_to_json(const ComputeReport& r, const std::string& error) {
       {"total_ms", total},
       {"summary",
        {{"min", r.summary.min}, {"median", r.summary.median}, {"mean", r.summary.mean}, {"max", r.summary.max}}},
-      {"warnings", r.warnings}};
+      {"warnings", r.warnings},
+      {"fingerprint", fingerprint}};
   return j.dump(2);
 }
 
-}  // namespace sdfkit::cli
+}  // namespace sdfkit

@@ -1,0 +1,65 @@
+#pragma once
+// Batch processing of many assets: expand inputs (files, directories, manifests), split them
+// into shards for an external scheduler, run several assets in flight, write each result
+// atomically beside a per-asset JSON record, and skip assets already done (resume).
+
+#include "sdfkit/pipeline.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace sdfkit {
+
+// Expands inputs into a sorted, de-duplicated list of mesh files: a file is taken as is; a
+// directory is searched recursively for .gltf .glb .obj .off .ply; a file ending in .list or
+// .manifest, or any "@FILE", is a manifest: one path per line ('#' comments, blank lines
+// ignored, relative paths relative to the manifest). Throws InputError for a missing input.
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs);
+
+// Shard `index` of `count` (0 <= index < count): every count-th input starting at index of the
+// sorted list, so shards are disjoint, cover everything, and do not depend on the machine.
+std::vector<std::string> select_shard(const std::vector<std::string>& sorted_inputs, int index, int count);
+
+// Parses "I/N" (throws InputError).
+std::pair<int, int> parse_shard(const std::string& text);
+
+struct BatchOptions {
+  std::string out_dir;
+  std::string format = "glb";      // output extension: glb gltf ply txt
+  int jobs = 2;                    // assets in flight (each with its own backend session)
+  bool force = false;              // recompute assets whose result is complete
+  ComputeRequest base;             // sdf/load/write/smooth options; input/output are set per asset
+  BackendConfig backend;
+  std::string report_name = "batch-report.json";  // final report, inside out_dir
+};
+
+enum class AssetStatus { Done, Skipped, Failed };
+
+struct AssetOutcome {
+  std::string input, output, record;  // record: the per-asset JSON file
+  AssetStatus status = AssetStatus::Failed;
+  std::string error;
+  double seconds = 0;
+};
+
+struct BatchSummary {
+  std::vector<AssetOutcome> assets;  // in input order
+  std::size_t done = 0, skipped = 0, failed = 0;
+  std::string report;                // path of the final JSON report
+};
+
+// Called after each asset (from worker threads, serialised): finished count, total, outcome.
+using BatchProgress = std::function<void(std::size_t, std::size_t, const AssetOutcome&)>;
+
+// Output path of an input inside out_dir: <stem>.<format>, or <stem>-<hash>.<format> when two
+// inputs share a stem.
+std::vector<std::string> plan_outputs(const std::vector<std::string>& inputs, const std::string& out_dir,
+                                      const std::string& format);
+
+// Runs the batch. Throws DeviceError before any work when no backend can be created; a bad
+// asset is recorded as Failed and the batch goes on.
+BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOptions& options,
+                       const BatchProgress& progress = {});
+
+}  // namespace sdfkit
