@@ -1,0 +1,70 @@
+// Batch planning without a device: input expansion, shards, output names.
+#include "sdfkit/batch.hpp"
+#include "sdfkit/core/error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+namespace fs = std::filesystem;
+using namespace sdfkit;
+
+namespace {
+class BatchPlan : public ::testing::Test {
+protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / "sdfkit_batch_plan";
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "a" / "deep");
+    fs::create_directories(dir_ / "b");
+    for (const char* f : {"a/x.off", "a/deep/y.glb", "a/notes.txt", "b/x.off", "b/z.PLY"})
+      std::ofstream(dir_ / f) << "x";
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+}  // namespace
+
+TEST_F(BatchPlan, DirectoriesAreSearchedForMeshFilesOnly) {
+  const auto files = expand_inputs({dir_.string()});
+  ASSERT_EQ(files.size(), 4u);  // notes.txt is not a mesh
+  EXPECT_TRUE(std::is_sorted(files.begin(), files.end()));
+}
+
+TEST_F(BatchPlan, ManifestsResolveRelativePathsAndDeduplicate) {
+  std::ofstream(dir_ / "jobs.list") << "# two assets\na/x.off\n\n  b/z.PLY  \na/x.off\n";
+  const auto files = expand_inputs({(dir_ / "jobs.list").string(), (dir_ / "a" / "x.off").string()});
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(fs::path(files[0]).filename(), "x.off");
+  EXPECT_EQ(fs::path(files[1]).filename(), "z.PLY");
+}
+
+TEST_F(BatchPlan, MissingInputIsAnError) {
+  EXPECT_THROW(expand_inputs({(dir_ / "nope").string()}), InputError);
+  std::ofstream(dir_ / "bad.list") << "missing.off\n";
+  EXPECT_THROW(expand_inputs({(dir_ / "bad.list").string()}), InputError);
+}
+
+TEST(BatchShard, ShardsAreDisjointAndCoverEverything) {
+  std::vector<std::string> inputs;
+  for (int i = 0; i < 23; ++i) inputs.push_back("f" + std::to_string(100 + i));
+  std::multiset<std::string> seen;
+  for (int i = 0; i < 4; ++i)
+    for (const auto& s : select_shard(inputs, i, 4)) seen.insert(s);
+  EXPECT_EQ(seen.size(), inputs.size());
+  EXPECT_EQ(std::set<std::string>(seen.begin(), seen.end()).size(), inputs.size());
+}
+
+TEST(BatchShard, ParsesIOverN) {
+  EXPECT_EQ(parse_shard("3/8"), std::make_pair(3, 8));
+  for (const char* bad : {"8/8", "-1/4", "1", "a/b", "1/0", "1/2x"}) EXPECT_THROW(parse_shard(bad), InputError) << bad;
+}
+
+TEST(BatchPlanOutputs, CollidingStemsGetAStableSuffix) {
+  const auto out = plan_outputs({"/p/a/x.off", "/p/b/x.off", "/p/c/y.obj"}, "/out", "glb");
+  EXPECT_NE(out[0], out[1]);
+  EXPECT_EQ(out[2], "/out/y.glb");
+  EXPECT_EQ(plan_outputs({"/p/a/x.off", "/p/b/x.off"}, "/out", "glb"), std::vector<std::string>(out.begin(), out.begin() + 2));
+}
