@@ -64,8 +64,11 @@ void add_compute_command(CLI::App& app) {
     req.sdf = a->sdf.sdf;
     req.write = a->sdf.write;
     req.smooth_rings = a->sdf.smooth;
-    std::unique_ptr<SdfBackend> backend = make_backend(a->sdf.backend_config);
-    const ComputeReport r = run_compute(req, *backend);
+    std::unique_ptr<SdfBackend> backend;
+    const ComputeReport r = run_compute(req, [&]() -> SdfBackend& {
+      backend = make_backend(a->sdf.backend_config);
+      return *backend;
+    });
     if (!a->json.empty()) {
       const std::string text = report_to_json(r);  // sdfkit::report_to_json
       io::write_file_atomically(a->json, [&](std::ostream& os) { os << text << '\n'; });

@@ -65,12 +65,14 @@ FieldSummary summarize(std::span<const float> values) {
 }
 
 ComputeReport run_compute(const ComputeRequest& request, SdfBackend& backend) {
+  return run_compute(request, [&]() -> SdfBackend& { return backend; });
+}
+
+ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& provider) {
   validate_options(request.sdf);
   ComputeReport report;
   report.input = request.input;
   report.output = request.output;
-  report.backend = backend.name();
-  report.device = backend.device_name();
   Stopwatch clock;
 
   // Fail on an unwritable output before spending the compute time.
@@ -87,6 +89,10 @@ ComputeReport run_compute(const ComputeRequest& request, SdfBackend& backend) {
   report.welded_vertices = asset.mesh.positions.size();
   report.warnings = asset.warnings;
 
+  SdfBackend& backend = provider();
+  report.backend = backend.name();
+  report.device = backend.device_name();
+  report.stages.push_back({"device", clock.lap_ms()});
   backend.set_mesh(asset.mesh);
   const double set_mesh_ms = clock.lap_ms();
   SdfField field = compute_sdf(backend, asset.mesh, request.sdf);

@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
+struct RunResult {
   int exit_code = -1;
   bool signaled = false;
   std::string out, err;
@@ -39,11 +39,11 @@ protected:
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Run run(const std::string& args) {
+  RunResult run(const std::string& args) {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
     const std::string cmd = std::string(SDFKIT_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
     const int status = std::system(cmd.c_str());
-    Run r;
+    RunResult r;
     r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = slurp(out);
@@ -56,7 +56,7 @@ protected:
     return p;
   }
   // One line on stderr, "sdfkit: error: ..." naming `what`, exit code 1.
-  void expect_clean_error(const Run& r, const std::string& what) {
+  void expect_clean_error(const RunResult& r, const std::string& what) {
     EXPECT_FALSE(r.signaled) << r.err;
     EXPECT_EQ(r.exit_code, 1) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -69,13 +69,13 @@ protected:
 }  // namespace
 
 TEST_F(Cli, Version) {
-  const Run r = run("--version");
+  const RunResult r = run("--version");
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.out.find("sdfkit "), std::string::npos);
 }
 
 TEST_F(Cli, InfoOnARealMesh) {
-  const Run r = run("info " + sdfkit::test::data_mesh("cow.off"));
+  const RunResult r = run("info " + sdfkit::test::data_mesh("cow.off"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("vertices:           2904"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("faces:              5804"), std::string::npos) << r.out;
@@ -84,13 +84,13 @@ TEST_F(Cli, InfoOnARealMesh) {
 }
 
 TEST_F(Cli, InfoReportsAnOpenMesh) {
-  const Run r = run("info " + sdfkit::test::data_mesh("cube-ouvert.off") + " --json");
+  const RunResult r = run("info " + sdfkit::test::data_mesh("cube-ouvert.off") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"closed\": false"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, InfoOnBuiltinShape) {
-  const Run r = run("info builtin:torus");
+  const RunResult r = run("info builtin:torus");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("boundary edges:     0"), std::string::npos) << r.out;
 }
@@ -143,7 +143,7 @@ TEST_F(Cli, FailedComputeWritesNothingAndKeepsAnExistingFile) {
 }
 
 TEST_F(Cli, BadOptionValuesAreUsageErrors) {
-  const Run r = run("compute builtin:sphere -o x.txt --rays 0");
+  const RunResult r = run("compute builtin:sphere -o x.txt --rays 0");
   EXPECT_FALSE(r.signaled);
   EXPECT_NE(r.exit_code, 0);
 }

@@ -6,6 +6,7 @@
 #include "sdfkit/core/sdf.hpp"
 #include "sdfkit/io/asset.hpp"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -48,5 +49,10 @@ std::string report_to_json(const ComputeReport& report, const std::string& error
 // Runs one job on an existing backend session (reused across jobs). Throws Error on failure;
 // nothing is written unless everything before the write succeeded.
 ComputeReport run_compute(const ComputeRequest& request, SdfBackend& backend);
+
+// The same, with the backend made on first use, after the input loaded: a bad file is reported
+// before any device is opened.
+using BackendProvider = std::function<SdfBackend&()>;
+ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& backend);
 
 }  // namespace sdfkit
