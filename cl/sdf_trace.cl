@@ -1,0 +1,131 @@
+// sdfkit OpenCL kernels, part 2: tracing rays through the octree (engine's octree.hpp layout).
+//
+// Nodes: uint2 (first, mask); mask bit 31 = leaf, then mask & 0x7fffffff triangles from
+// refs[first]; else bits 0..7 name the stored octants, child k at first + popcount(mask below k).
+// Cells: float4 (min corner xyz, side w). Faces: three float4 per face (v0, e1 = v1 - v0,
+// e2 = v2 - v0) whose w components hold the outward unit normal.
+//
+// Traversal (after Laine & Karras 2010): the ray's octant mask mirrors the child order, so
+// visiting octants j ^ mask for j = 0..7 is front to back for any ray; each internal node pushes
+// the children its t-interval enters (slab tests against the parent's mid planes) in reverse,
+// and the walk stops as soon as the next node starts beyond the closest hit found so far.
+
+#define LEAF_BIT 0x80000000u
+
+// Moller-Trumbore: updates (*best_t, *best_f) when face f is hit at 0 < t < *best_t.
+inline void hit_triangle(__global const float4* faces, uint f, float3 o, float3 d,
+                         float* best_t, uint* best_f) {
+  const float3 v0 = faces[3 * f].xyz, e1 = faces[3 * f + 1].xyz, e2 = faces[3 * f + 2].xyz;
+  const float3 pv = cross(d, e2);
+  const float det = dot(e1, pv);
+  if (det == 0.0f) return;
+  const float inv_det = 1.0f / det;
+  const float3 tv = o - v0;
+  const float u = dot(tv, pv) * inv_det;
+  if (u < 0.0f || u > 1.0f) return;
+  const float3 qv = cross(tv, e1);
+  const float v = dot(d, qv) * inv_det;
+  if (v < 0.0f || u + v > 1.0f) return;
+  const float t = dot(e2, qv) * inv_det;
+  if (t > 0.0f && t < *best_t) {
+    *best_t = t;
+    *best_f = f;
+  }
+}
+
+// Closest hit of the ray o + t d (t > 0): returns the face or 0xffffffff, and its t.
+inline uint closest_hit(__global const uint2* nodes, __global const float4* cells,
+                        __global const uint* refs, __global const float4* faces, float3 o,
+                        float3 d, float* t_out) {
+  const float tiny = 1e-20f;
+  const float3 dd = (float3)(fabs(d.x) < tiny ? copysign(tiny, d.x) : d.x,
+                             fabs(d.y) < tiny ? copysign(tiny, d.y) : d.y,
+                             fabs(d.z) < tiny ? copysign(tiny, d.z) : d.z);
+  const float3 inv = 1.0f / dd;
+  // From dd, not d: a -0.0 component has become -1e-20, and the octant must agree with inv.
+  const uint octant = (dd.x < 0.0f ? 1u : 0u) | (dd.y < 0.0f ? 2u : 0u) | (dd.z < 0.0f ? 4u : 0u);
+  // Per axis, which side of a cell the ray enters through (0 = low plane, 1 = high plane).
+  const float3 enter_side = (float3)(octant & 1u ? 1.0f : 0.0f, octant & 2u ? 1.0f : 0.0f,
+                                     octant & 4u ? 1.0f : 0.0f);
+
+  float best_t = INFINITY;
+  uint best_f = 0xffffffffu;
+
+  uint stack_node[STACK_SIZE];
+  float stack_t[STACK_SIZE];
+  int sp = 0;
+  {
+    const float4 c = cells[0];
+    const float3 t0 = (c.xyz + enter_side * c.w - o) * inv;
+    const float3 t1 = (c.xyz + (1.0f - enter_side) * c.w - o) * inv;
+    const float tin = fmax(fmax(fmax(t0.x, t0.y), t0.z), 0.0f);
+    const float tout = fmin(fmin(t1.x, t1.y), t1.z);
+    if (tin <= tout) {
+      stack_node[0] = 0;
+      stack_t[0] = tin;
+      sp = 1;
+    }
+  }
+  while (sp > 0) {
+    --sp;
+    if (stack_t[sp] >= best_t) break;  // everything left starts beyond the closest hit
+    const uint node = stack_node[sp];
+    const uint2 nd = nodes[node];
+    if (nd.y & LEAF_BIT) {
+      const uint end = nd.x + (nd.y & ~LEAF_BIT);
+      for (uint k = nd.x; k < end; ++k) hit_triangle(faces, refs[k], o, d, &best_t, &best_f);
+      continue;
+    }
+    const float4 c = cells[node];
+    const float half_side = 0.5f * c.w;
+    const float3 t0 = (c.xyz + enter_side * c.w - o) * inv;
+    const float3 tm = (c.xyz + half_side - o) * inv;
+    const float3 t1 = (c.xyz + (1.0f - enter_side) * c.w - o) * inv;
+    // j: octant in the mirrored frame (bit set = the far half along that axis).
+    for (int j = 7; j >= 0; --j) {
+      const uint k = (uint)j ^ octant;
+      if (!(nd.y & (1u << k))) continue;
+      const float ex = (j & 1) ? tm.x : t0.x, ey = (j & 2) ? tm.y : t0.y,
+                  ez = (j & 4) ? tm.z : t0.z;
+      const float xx = (j & 1) ? t1.x : tm.x, xy = (j & 2) ? t1.y : tm.y,
+                  xz = (j & 4) ? t1.z : tm.z;
+      const float tin = fmax(fmax(fmax(ex, ey), ez), 0.0f);
+      const float tout = fmin(fmin(fmin(xx, xy), xz), best_t);
+      if (tin > tout || sp >= STACK_SIZE) continue;
+      stack_node[sp] = nd.x + popcount(nd.y & ((1u << k) - 1u));
+      stack_t[sp] = tin;
+      ++sp;
+    }
+  }
+  *t_out = best_t;
+  return best_f;
+}
+
+// One work item per ray, point-major (the rays of a point in neighbouring work items).
+// points: xyz = surface point, w = 1 when the point casts rays; normals: xyz = outward unit
+// normal. Writes keys[g] = (bits of the accepted length << 32) | ray index, or NO_HIT_KEY.
+__kernel void trace_rays(__global const uint2* nodes, __global const float4* cells,
+                         __global const uint* refs, __global const float4* faces,
+                         __global const float4* points, __global const float4* normals,
+                         __global const float4* table, int n_rays, uint n_points,
+                         float origin_offset, int rule, __global ulong* keys) {
+  const uint g = get_global_id(0);
+  if (g >= n_points * (uint)n_rays) return;
+  const uint p = g / (uint)n_rays, r = g - p * (uint)n_rays;
+  const float4 pt = points[p];
+  ulong key = NO_HIT_KEY;
+  if (pt.w != 0.0f) {
+    const float3 n = normals[p].xyz;
+    const float3 d = ray_direction(n, table[r].xyz);
+    const float3 o = pt.xyz - origin_offset * n;
+    float t;
+    const uint f = closest_hit(nodes, cells, refs, faces, o, d, &t);
+    if (f != 0xffffffffu) {
+      const float3 hn = (float3)(faces[3 * f].w, faces[3 * f + 1].w, faces[3 * f + 2].w);
+      // Paper: drop hits facing the same way as the start normal; Cgal: keep exits only.
+      const bool accept = rule == 0 ? dot(hn, n) <= 0.0f : dot(d, hn) > 0.0f;
+      if (accept) key = ((ulong)as_uint(t) << 32) | (ulong)r;
+    }
+  }
+  keys[g] = key;
+}

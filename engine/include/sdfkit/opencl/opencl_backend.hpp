@@ -1,0 +1,92 @@
+#pragma once
+// The OpenCL ray-casting backend (Shapira et al. 2008, section 3.2): an octree over the
+// triangles built on the host, rays generated, traced and gathered on the device, one float and
+// one kept-ray count per point read back.
+//
+// A backend object is a session: it holds the OpenCL context, the compiled program, its kernels
+// and the uploaded geometry, so a caller that moves vertices (update_positions) and computes
+// again pays only the octree rebuild, the re-upload and the tracing.
+//
+// Device memory: the geometry (per face 64 bytes + the octree) stays resident; the per-point
+// buffers (inputs, one 8-byte key per ray, outputs) are sized to fit OpenClConfig::memory_cap,
+// and the points are processed in as many batches as that takes.
+
+#include "sdfkit/core/sdf.hpp"
+#include "sdfkit/opencl/octree.hpp"
+
+#include <glm/vec4.hpp>
+
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace sdfkit::cl {
+
+struct DeviceInfo {
+  std::string platform, name, vendor, version;
+  std::string type;  // "GPU", "CPU", "accelerator", "other"
+  std::size_t global_memory = 0;  // bytes
+  int index = 0;                  // position in list_devices(), usable as a selector
+};
+
+// Every OpenCL device of every platform. Empty when no platform is installed (never throws for
+// a missing ICD); throws DeviceError for other driver failures.
+std::vector<DeviceInfo> list_devices();
+
+struct OpenClConfig {
+  // "" = the environment variable SDFKIT_CL_DEVICE, or when that is unset or empty the first
+  // GPU, else the first device of any kind. Otherwise an index into list_devices() ("0") or a
+  // case-insensitive substring of the device name ("nvidia", "pthread").
+  std::string device;
+  // Bytes of device memory for the per-batch point buffers (not the geometry).
+  std::size_t memory_cap = std::size_t{512} << 20;
+  // Octree: deepest level (root = 0) and the triangle count under which a node stays a leaf.
+  int octree_max_depth = 10;
+  int octree_leaf_size = 8;
+  // Work-group size of the trace kernel; 0 lets the driver choose.
+  std::size_t work_group_size = 0;
+};
+
+class OpenClBackend final : public SdfBackend {
+public:
+  // Picks the device, creates the context and queue and compiles the kernels. Throws
+  // DeviceError when no platform or no matching device exists or the kernels fail to build
+  // (the message holds the build log).
+  explicit OpenClBackend(const OpenClConfig& config = {});
+  ~OpenClBackend() override;
+
+  std::string name() const override { return "opencl"; }
+  std::string device_name() const override;
+  void set_mesh(const Mesh& mesh) override;
+  void update_positions(std::span<const glm::vec3> positions) override;
+  RawSdf compute(const SdfQuery& query, const SdfOptions& options) override;
+  // "octree_build" and "upload" of the last set_mesh/update_positions, "trace_gather" of the
+  // last compute (milliseconds, wall clock, including the queue's completion).
+  std::vector<StageTiming> last_timings() const override;
+  // Geometry + octree + the per-batch buffers of the last compute, in bytes.
+  std::size_t device_memory_bytes() const override;
+
+  const DeviceInfo& device() const;
+  const Octree& octree() const;
+  // Points per batch the memory cap allows for `rays` rays per point.
+  std::size_t batch_points(int rays) const;
+
+  // Test entry points: the device's own versions of the shared definition, run in isolation.
+  // Rays: for every normal (outward, unit), the `options.rays` rays of its cone as generated on
+  // the device: xyz = world direction, w = the ray's weight; normals.size() * rays entries,
+  // point-major.
+  std::vector<glm::vec4> ray_directions_for_test(std::span<const glm::vec3> normals,
+                                                 const SdfOptions& options);
+  // Gather: `lengths` holds rays_per_point entries per point (negative or NaN = no accepted
+  // hit), `weights` one weight per ray index; returns the device gather's value and kept count.
+  RawSdf gather_lengths_for_test(std::span<const float> lengths, std::span<const float> weights,
+                                 int rays_per_point);
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sdfkit::cl

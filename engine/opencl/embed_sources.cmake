@@ -1,0 +1,20 @@
+# Writes a C++ file defining the OpenCL program source, the given .cl files concatenated in
+# order, as one raw string literal. Run as: cmake -DOUT=<file.cpp> -DSOURCES=<a.cl;b.cl> -P ...
+# (a build step: the output lands in the build tree and is regenerated when a .cl changes).
+set(_body "")
+foreach(src IN LISTS SOURCES)
+  file(READ "${src}" _text)
+  if(_text MATCHES "\\)sdfkit_cl\"")
+    message(FATAL_ERROR "${src} contains the raw-string delimiter )sdfkit_cl\"")
+  endif()
+  get_filename_component(_name "${src}" NAME)
+  string(APPEND _body "// ---- ${_name}\n${_text}\n")
+endforeach()
+set(_cpp "// Generated from cl/*.cl by engine/opencl/embed_sources.cmake; do not edit.\n")
+string(APPEND _cpp "namespace sdfkit::cl::detail {\n")
+string(APPEND _cpp "extern const char* const kProgramSource;\n")
+string(APPEND _cpp "const char* const kProgramSource = R\"sdfkit_cl(${_body})sdfkit_cl\";\n")
+string(APPEND _cpp "}  // namespace sdfkit::cl::detail\n")
+file(WRITE "${OUT}.tmp" "${_cpp}")
+file(COPY_FILE "${OUT}.tmp" "${OUT}" ONLY_IF_DIFFERENT)
+file(REMOVE "${OUT}.tmp")

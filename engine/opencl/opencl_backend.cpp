@@ -1,0 +1,454 @@
+#include "sdfkit/opencl/opencl_backend.hpp"
+
+#include "cl_api.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <string>
+
+namespace sdfkit::cl {
+
+namespace detail {
+extern const char* const kProgramSource;  // cl/*.cl, embedded at build time
+}
+
+using detail::check;
+
+namespace {
+
+constexpr std::uint64_t kNoHitKey = ~std::uint64_t{0};
+
+const char* const kNoPlatform =
+    "no OpenCL platform found; install an OpenCL driver, e.g. Debian packages "
+    "ocl-icd-libopencl1 and pocl-opencl-icd (CPU) or your GPU vendor's OpenCL ICD";
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+DeviceInfo to_info(const detail::FoundDevice& d, int index) {
+  return DeviceInfo{d.platform_name, d.name, d.vendor, d.version, d.type, d.global_memory, index};
+}
+
+std::string describe(const std::vector<detail::FoundDevice>& devices) {
+  std::string s;
+  for (std::size_t i = 0; i < devices.size(); ++i)
+    s += (i ? "; " : "") + std::to_string(i) + ": " + devices[i].name + " (" +
+         devices[i].platform_name + ", " + devices[i].type + ")";
+  return s;
+}
+
+// The device the selector names (see OpenClConfig::device). Throws DeviceError with the list of
+// devices when nothing matches.
+std::size_t select_device(const std::vector<detail::FoundDevice>& devices, std::string selector) {
+  if (devices.empty()) throw DeviceError(kNoPlatform);
+  if (selector.empty())
+    if (const char* env = std::getenv("SDFKIT_CL_DEVICE")) selector = env;
+  if (selector.empty()) {
+    for (std::size_t i = 0; i < devices.size(); ++i)
+      if (devices[i].type == "GPU") return i;
+    return 0;
+  }
+  const bool numeric = std::all_of(selector.begin(), selector.end(),
+                                   [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+  if (numeric) {
+    const unsigned long index = std::stoul(selector);
+    if (index < devices.size()) return index;
+  } else {
+    for (std::size_t i = 0; i < devices.size(); ++i)
+      if (lower(devices[i].name).find(lower(selector)) != std::string::npos) return i;
+  }
+  throw DeviceError("no OpenCL device matches \"" + selector + "\" (set by --device or " +
+                    "SDFKIT_CL_DEVICE); available devices: " + describe(devices));
+}
+
+// OpenCL major.minor from a CL_DEVICE_VERSION string ("OpenCL 3.0 PoCL ..."), as 10*major+minor.
+int parse_version(const std::string& v) {
+  int major = 0, minor = 0;
+  if (std::sscanf(v.c_str(), "OpenCL %d.%d", &major, &minor) != 2) return 0;
+  return major * 10 + minor;
+}
+
+template <typename T>
+void set_arg(cl_kernel kernel, cl_uint index, const T& value, const char* kernel_name) {
+  check(clSetKernelArg(kernel, index, sizeof(T), &value),
+        std::string("setting argument ") + std::to_string(index) + " of kernel " + kernel_name);
+}
+
+template <typename... Args>
+void set_args(cl_kernel kernel, const char* kernel_name, const Args&... args) {
+  cl_uint i = 0;
+  (set_arg(kernel, i++, args, kernel_name), ...);
+}
+
+std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m - 1) / m * m; }
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+std::vector<DeviceInfo> list_devices() {
+  const auto found = detail::enumerate_devices();
+  std::vector<DeviceInfo> out;
+  for (std::size_t i = 0; i < found.size(); ++i) out.push_back(to_info(found[i], static_cast<int>(i)));
+  return out;
+}
+
+struct OpenClBackend::Impl {
+  OpenClConfig config;
+  DeviceInfo info;
+  cl_device_id device = nullptr;
+  std::size_t max_alloc = 0;
+  detail::Context context;
+  detail::Queue queue;
+  detail::Program program;
+  detail::Kernel k_cone, k_trace, k_gather, k_dirs;
+
+  // Geometry (resident between computes).
+  Mesh mesh;
+  bool has_mesh = false;
+  Octree octree;
+  detail::Buffer nodes, cells, refs, faces;
+  std::size_t geometry_bytes = 0;
+
+  // The cone table of the last (rays, cone) and the per-batch buffers.
+  detail::Buffer table;
+  int table_rays = 0;
+  float table_cone = 0.0f;
+  detail::Buffer points, normals, keys, values, kept;
+  std::size_t batch_bytes = 0;
+
+  double octree_ms = 0.0, upload_ms = 0.0, trace_ms = 0.0;
+
+  void create(const OpenClConfig& cfg);
+  void build_program();
+  detail::Kernel make_kernel(const char* name);
+  void rebuild_geometry();
+  void ensure_table(int rays, float cone_degrees);
+  void write(cl_mem buffer, std::size_t bytes, const void* data, const char* what);
+  void run(cl_kernel kernel, std::size_t items, std::size_t local, const char* name);
+  void finish(const char* what) { check(clFinish(queue.get()), what); }
+};
+
+void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
+  config = cfg;
+  if (cfg.memory_cap == 0) throw InputError("the OpenCL memory cap must be positive");
+  const auto devices = detail::enumerate_devices();
+  const std::size_t index = select_device(devices, cfg.device);
+  const detail::FoundDevice& d = devices[index];
+  info = to_info(d, static_cast<int>(index));
+  device = d.device;
+  if (parse_version(d.version) < 12)
+    throw DeviceError("the OpenCL device " + d.name + " reports \"" + d.version +
+                      "\"; sdfkit needs OpenCL 1.2 or later");
+  cl_ulong alloc = 0;
+  check(clGetDeviceInfo(device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(alloc), &alloc, nullptr),
+        "querying the device's largest allocation");
+  max_alloc = static_cast<std::size_t>(alloc);
+
+  cl_int status = CL_SUCCESS;
+  const cl_context_properties props[] = {
+      CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(d.platform), 0};
+  context = detail::Context(clCreateContext(props, 1, &device, nullptr, nullptr, &status));
+  check(status, "creating a context on " + d.name);
+  queue = detail::Queue(clCreateCommandQueue(context.get(), device, 0, &status));
+  check(status, "creating a command queue on " + d.name);
+  build_program();
+  k_cone = make_kernel("make_cone");
+  k_trace = make_kernel("trace_rays");
+  k_gather = make_kernel("gather_points");
+  k_dirs = make_kernel("ray_directions");
+}
+
+void OpenClBackend::Impl::build_program() {
+  const char* source = detail::kProgramSource;
+  cl_int status = CL_SUCCESS;
+  program = detail::Program(clCreateProgramWithSource(context.get(), 1, &source, nullptr, &status));
+  check(status, "loading the OpenCL program source");
+  // A node pops one entry and pushes at most 8 children: 7 per level plus the root.
+  const int stack = 7 * std::max(config.octree_max_depth, 1) + 2;
+  std::string options = "-cl-std=CL1.2 -DSTACK_SIZE=" + std::to_string(stack);
+  cl_device_fp_config fp = 0;
+  check(clGetDeviceInfo(device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, nullptr),
+        "querying the device's float support");
+  // The gather divides and takes a square root like the C++ definition only when both are
+  // correctly rounded; devices that cannot do it stay within the spec's few ulps.
+  if (fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT) options += " -cl-fp32-correctly-rounded-divide-sqrt";
+  status = clBuildProgram(program.get(), 1, &device, options.c_str(), nullptr, nullptr);
+  if (status != CL_SUCCESS) {
+    std::size_t size = 0;
+    clGetProgramBuildInfo(program.get(), device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
+    std::string log(size, '\0');
+    clGetProgramBuildInfo(program.get(), device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+    while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
+    throw DeviceError("the OpenCL kernels failed to build for " + info.name + " (" +
+                      detail::status_name(status) + "); build log:\n" + log);
+  }
+}
+
+detail::Kernel OpenClBackend::Impl::make_kernel(const char* name) {
+  cl_int status = CL_SUCCESS;
+  detail::Kernel k(clCreateKernel(program.get(), name, &status));
+  check(status, std::string("creating kernel ") + name);
+  return k;
+}
+
+void OpenClBackend::Impl::write(cl_mem buffer, std::size_t bytes, const void* data,
+                                const char* what) {
+  if (bytes == 0) return;
+  check(clEnqueueWriteBuffer(queue.get(), buffer, CL_FALSE, 0, bytes, data, 0, nullptr, nullptr),
+        std::string("uploading ") + what);
+}
+
+void OpenClBackend::Impl::run(cl_kernel kernel, std::size_t items, std::size_t local,
+                              const char* name) {
+  if (items == 0) return;
+  const std::size_t global = round_up(items, local);
+  check(clEnqueueNDRangeKernel(queue.get(), kernel, 1, nullptr, &global,
+                               local ? &local : nullptr, 0, nullptr, nullptr),
+        std::string("running kernel ") + name);
+}
+
+// Host: builds the octree and the per-face records; device: uploads them into buffers that
+// only grow, so moving vertices reuses the allocations.
+void OpenClBackend::Impl::rebuild_geometry() {
+  auto start = std::chrono::steady_clock::now();
+  octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
+  const std::vector<glm::vec3> normals_f = face_normals(mesh);
+  std::vector<glm::vec4> face_data(3 * mesh.triangles.size());
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    const glm::vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+    face_data[3 * f] = glm::vec4(a, normals_f[f].x);
+    face_data[3 * f + 1] = glm::vec4(b - a, normals_f[f].y);
+    face_data[3 * f + 2] = glm::vec4(c - a, normals_f[f].z);
+  }
+  octree_ms = ms_since(start);
+
+  start = std::chrono::steady_clock::now();
+  const auto bytes_of = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  const cl_context ctx = context.get();
+  nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
+  cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
+  refs.reserve(ctx, bytes_of(octree.refs), CL_MEM_READ_ONLY, "octree triangle lists");
+  faces.reserve(ctx, bytes_of(face_data), CL_MEM_READ_ONLY, "triangles");
+  write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
+  write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
+  write(refs.get(), bytes_of(octree.refs), octree.refs.data(), "octree triangle lists");
+  write(faces.get(), bytes_of(face_data), face_data.data(), "triangles");
+  finish("uploading the mesh");
+  upload_ms = ms_since(start);
+  geometry_bytes = nodes.size() + cells.size() + refs.size() + faces.size();
+}
+
+void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
+  if (table.get() && table_rays == rays && table_cone == cone_degrees) return;
+  table.reserve(context.get(), sizeof(cl_float4) * static_cast<std::size_t>(rays),
+                CL_MEM_READ_WRITE, "the cone's rays");
+  const double half = 0.5 * static_cast<double>(cone_degrees) * M_PI / 180.0;
+  const auto one_minus_cos = static_cast<float>(1.0 - std::cos(half));
+  // The golden angle in turns, split so that i * c_hi is exact in float for i < 2^10.
+  const double turns = kGoldenAngle / (2.0 * M_PI);
+  const double c_hi = std::round(turns * 8192.0) / 8192.0;
+  const auto f_hi = static_cast<float>(c_hi), f_lo = static_cast<float>(turns - c_hi);
+  const cl_mem t = table.get();
+  set_args(k_cone.get(), "make_cone", cl_int{rays}, one_minus_cos, f_hi, f_lo, t);
+  run(k_cone.get(), static_cast<std::size_t>(rays), 0, "make_cone");
+  table_rays = rays;
+  table_cone = cone_degrees;
+}
+
+OpenClBackend::OpenClBackend(const OpenClConfig& config) : impl_(std::make_unique<Impl>()) {
+  impl_->create(config);
+}
+
+OpenClBackend::~OpenClBackend() = default;
+
+std::string OpenClBackend::device_name() const {
+  return impl_->info.name + " (" + impl_->info.platform + ", OpenCL)";
+}
+
+const DeviceInfo& OpenClBackend::device() const { return impl_->info; }
+const Octree& OpenClBackend::octree() const { return impl_->octree; }
+
+void OpenClBackend::set_mesh(const Mesh& mesh) {
+  validate_mesh(mesh, "the mesh given to the OpenCL backend");
+  impl_->mesh = mesh;
+  impl_->has_mesh = true;
+  impl_->rebuild_geometry();
+}
+
+void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
+  if (!impl_->has_mesh) throw Error("update_positions was called before set_mesh");
+  if (positions.size() != impl_->mesh.positions.size())
+    throw Error("update_positions got " + std::to_string(positions.size()) +
+                " positions for a mesh of " + std::to_string(impl_->mesh.positions.size()) +
+                " vertices");
+  for (const glm::vec3& p : positions)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw InputError("update_positions got a non-finite coordinate");
+  impl_->mesh.positions.assign(positions.begin(), positions.end());
+  impl_->rebuild_geometry();
+}
+
+std::size_t OpenClBackend::batch_points(int rays) const {
+  const std::size_t per_point = 2 * sizeof(cl_float4) + sizeof(cl_ulong) * static_cast<std::size_t>(rays) +
+                                sizeof(cl_float) + sizeof(cl_uint);
+  std::size_t n = impl_->config.memory_cap / per_point;
+  // No single buffer may exceed the device's largest allocation; global sizes stay in 32 bits.
+  n = std::min(n, impl_->max_alloc / (sizeof(cl_ulong) * static_cast<std::size_t>(rays)));
+  n = std::min(n, static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max()) /
+                      static_cast<std::size_t>(rays));
+  if (n == 0)
+    throw InputError("the OpenCL memory cap of " + std::to_string(impl_->config.memory_cap) +
+                     " bytes is too small for one point with " + std::to_string(rays) + " rays");
+  return n;
+}
+
+RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) {
+  validate_options(options);
+  Impl& m = *impl_;
+  if (!m.has_mesh) throw Error("compute was called before set_mesh");
+  const std::size_t n = query.size();
+  if (query.normals.size() != n || query.valid.size() != n)
+    throw Error("the query's origins, normals and valid flags differ in length");
+  const auto start = std::chrono::steady_clock::now();
+  RawSdf raw;
+  raw.values.assign(n, 0.0f);
+  raw.kept_rays.assign(n, 0u);
+  if (n == 0) {
+    m.trace_ms = ms_since(start);
+    return raw;
+  }
+  const int rays = options.rays;
+  const auto nr = static_cast<std::size_t>(rays);
+  m.ensure_table(rays, options.cone_degrees);
+
+  const std::size_t batch = std::min(batch_points(rays), n);
+  const cl_context ctx = m.context.get();
+  m.points.reserve(ctx, batch * sizeof(cl_float4), CL_MEM_READ_ONLY, "query points");
+  m.normals.reserve(ctx, batch * sizeof(cl_float4), CL_MEM_READ_ONLY, "query normals");
+  m.keys.reserve(ctx, batch * nr * sizeof(cl_ulong), CL_MEM_READ_WRITE, "ray lengths");
+  m.values.reserve(ctx, batch * sizeof(cl_float), CL_MEM_WRITE_ONLY, "SDF values");
+  m.kept.reserve(ctx, batch * sizeof(cl_uint), CL_MEM_WRITE_ONLY, "kept-ray counts");
+  m.batch_bytes = m.points.size() + m.normals.size() + m.keys.size() + m.values.size() +
+                  m.kept.size() + m.table.size();
+
+  std::vector<glm::vec4> pts(n), nrm(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    pts[i] = glm::vec4(query.origins[i], query.valid[i] ? 1.0f : 0.0f);
+    nrm[i] = glm::vec4(query.normals[i], 0.0f);
+  }
+  const cl_int rule = static_cast<cl_int>(options.false_hit);
+  for (std::size_t first = 0; first < n; first += batch) {
+    const std::size_t count = std::min(batch, n - first);
+    const auto count32 = static_cast<cl_uint>(count);
+    m.write(m.points.get(), count * sizeof(cl_float4), &pts[first], "query points");
+    m.write(m.normals.get(), count * sizeof(cl_float4), &nrm[first], "query normals");
+    set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.refs.get(),
+             m.faces.get(), m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
+             query.origin_offset, rule, m.keys.get());
+    m.run(m.k_trace.get(), count * nr, m.config.work_group_size, "trace_rays");
+    set_args(m.k_gather.get(), "gather_points", m.keys.get(), cl_int{rays}, count32,
+             m.table.get(), m.values.get(), m.kept.get());
+    m.run(m.k_gather.get(), count, 0, "gather_points");
+    check(clEnqueueReadBuffer(m.queue.get(), m.values.get(), CL_FALSE, 0, count * sizeof(float),
+                              &raw.values[first], 0, nullptr, nullptr),
+          "reading SDF values back");
+    check(clEnqueueReadBuffer(m.queue.get(), m.kept.get(), CL_FALSE, 0,
+                              count * sizeof(std::uint32_t), &raw.kept_rays[first], 0, nullptr,
+                              nullptr),
+          "reading kept-ray counts back");
+    // The host arrays of this batch stay alive until the finish below; the in-order queue
+    // makes the next batch's uploads wait for this batch's kernels.
+  }
+  m.finish("tracing rays");
+  m.trace_ms = ms_since(start);
+  return raw;
+}
+
+std::vector<StageTiming> OpenClBackend::last_timings() const {
+  return {{"octree_build", impl_->octree_ms},
+          {"upload", impl_->upload_ms},
+          {"trace_gather", impl_->trace_ms}};
+}
+
+std::size_t OpenClBackend::device_memory_bytes() const {
+  return impl_->geometry_bytes + impl_->batch_bytes;
+}
+
+std::vector<glm::vec4> OpenClBackend::ray_directions_for_test(std::span<const glm::vec3> normals,
+                                                              const SdfOptions& options) {
+  validate_options(options);
+  Impl& m = *impl_;
+  m.ensure_table(options.rays, options.cone_degrees);
+  const std::size_t n = normals.size(), nr = static_cast<std::size_t>(options.rays);
+  std::vector<glm::vec4> in(n);
+  for (std::size_t i = 0; i < n; ++i) in[i] = glm::vec4(normals[i], 0.0f);
+  detail::Buffer in_buf, out_buf;
+  in_buf.reserve(m.context.get(), n * sizeof(cl_float4), CL_MEM_READ_ONLY, "test normals");
+  out_buf.reserve(m.context.get(), n * nr * sizeof(cl_float4), CL_MEM_WRITE_ONLY, "test directions");
+  m.write(in_buf.get(), n * sizeof(cl_float4), in.data(), "test normals");
+  set_args(m.k_dirs.get(), "ray_directions", in_buf.get(), m.table.get(), cl_int{options.rays},
+           static_cast<cl_uint>(n), out_buf.get());
+  m.run(m.k_dirs.get(), n * nr, 0, "ray_directions");
+  std::vector<glm::vec4> out(n * nr);
+  check(clEnqueueReadBuffer(m.queue.get(), out_buf.get(), CL_TRUE, 0, out.size() * sizeof(cl_float4),
+                            out.data(), 0, nullptr, nullptr),
+        "reading test directions back");
+  return out;
+}
+
+RawSdf OpenClBackend::gather_lengths_for_test(std::span<const float> lengths,
+                                              std::span<const float> weights, int rays_per_point) {
+  Impl& m = *impl_;
+  if (rays_per_point < 1 || weights.size() != static_cast<std::size_t>(rays_per_point) ||
+      lengths.size() % weights.size() != 0)
+    throw InputError("gather_lengths_for_test needs rays_per_point weights and whole points");
+  const std::size_t nr = weights.size(), n = lengths.size() / nr;
+  std::vector<std::uint64_t> keys(lengths.size());
+  for (std::size_t i = 0; i < lengths.size(); ++i) {
+    std::uint32_t bits = 0;
+    std::memcpy(&bits, &lengths[i], sizeof(bits));
+    keys[i] = lengths[i] >= 0.0f ? (std::uint64_t{bits} << 32) | (i % nr) : kNoHitKey;
+  }
+  std::vector<glm::vec4> table(nr);
+  for (std::size_t i = 0; i < nr; ++i) table[i] = glm::vec4(0.0f, 0.0f, 0.0f, weights[i]);
+  detail::Buffer key_buf, table_buf, value_buf, kept_buf;
+  const cl_context ctx = m.context.get();
+  key_buf.reserve(ctx, keys.size() * sizeof(cl_ulong), CL_MEM_READ_WRITE, "test lengths");
+  table_buf.reserve(ctx, nr * sizeof(cl_float4), CL_MEM_READ_ONLY, "test weights");
+  value_buf.reserve(ctx, n * sizeof(cl_float), CL_MEM_WRITE_ONLY, "test values");
+  kept_buf.reserve(ctx, n * sizeof(cl_uint), CL_MEM_WRITE_ONLY, "test counts");
+  m.write(key_buf.get(), keys.size() * sizeof(cl_ulong), keys.data(), "test lengths");
+  m.write(table_buf.get(), nr * sizeof(cl_float4), table.data(), "test weights");
+  set_args(m.k_gather.get(), "gather_points", key_buf.get(), cl_int{rays_per_point},
+           static_cast<cl_uint>(n), table_buf.get(), value_buf.get(), kept_buf.get());
+  m.run(m.k_gather.get(), n, 0, "gather_points");
+  RawSdf raw;
+  raw.values.resize(n);
+  raw.kept_rays.resize(n);
+  check(clEnqueueReadBuffer(m.queue.get(), value_buf.get(), CL_TRUE, 0, n * sizeof(float),
+                            raw.values.data(), 0, nullptr, nullptr),
+        "reading test values back");
+  check(clEnqueueReadBuffer(m.queue.get(), kept_buf.get(), CL_TRUE, 0, n * sizeof(std::uint32_t),
+                            raw.kept_rays.data(), 0, nullptr, nullptr),
+        "reading test counts back");
+  return raw;
+}
+
+}  // namespace sdfkit::cl

@@ -1,0 +1,30 @@
+#pragma once
+// One OpenCL backend shared by all tests of the binary (the program is compiled once).
+// Without an OpenCL device the tests fail, unless SDFKIT_ALLOW_NO_DEVICE=1 makes them skip.
+
+#include "sdfkit/opencl/opencl_backend.hpp"
+
+#include <gtest/gtest.h>
+
+namespace sdfkit::test {
+
+// The shared backend, or nullptr when no device exists (then the caller has already been
+// failed or skipped: use SDFKIT_REQUIRE_CL).
+cl::OpenClBackend* opencl_backend();
+
+}  // namespace sdfkit::test
+
+// Binds `var` to the shared backend; fails (or skips, with SDFKIT_ALLOW_NO_DEVICE=1) the test
+// when there is no OpenCL device.
+#define SDFKIT_REQUIRE_CL(var)                                            \
+  cl::OpenClBackend* var##_ptr = ::sdfkit::test::opencl_backend();        \
+  if (var##_ptr == nullptr) {                                             \
+    if (::sdfkit::test::no_device_allowed())                              \
+      GTEST_SKIP() << "no OpenCL device (SDFKIT_ALLOW_NO_DEVICE=1)";      \
+    FAIL() << "no OpenCL device; install pocl-opencl-icd or set SDFKIT_ALLOW_NO_DEVICE=1"; \
+  }                                                                       \
+  cl::OpenClBackend& var = *var##_ptr
+
+namespace sdfkit::test {
+bool no_device_allowed();
+}

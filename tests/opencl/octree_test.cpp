@@ -1,0 +1,122 @@
+// The host octree: overlap test, invariants of the flattened tree, and completeness (every
+// triangle that touches a leaf's cell is referenced from it).
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/opencl/octree.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <set>
+
+using namespace sdfkit;
+using sdfkit::cl::build_octree;
+using sdfkit::cl::Octree;
+using sdfkit::cl::OctreeNode;
+using sdfkit::cl::OctreeParams;
+using sdfkit::cl::triangle_overlaps_box;
+
+TEST(Octree, TriangleBoxOverlapUsesTheTriangleNotItsBox) {
+  const glm::vec3 lo(0, 0, 0), hi(1, 1, 1);
+  // Inside, and crossing the box with all vertices outside.
+  EXPECT_TRUE(triangle_overlaps_box({0.2f, 0.2f, 0.5f}, {0.8f, 0.2f, 0.5f}, {0.5f, 0.8f, 0.5f}, lo, hi));
+  EXPECT_TRUE(triangle_overlaps_box({-5, -5, 0.5f}, {5, -5, 0.5f}, {0, 10, 0.5f}, lo, hi));
+  // Far away.
+  EXPECT_FALSE(triangle_overlaps_box({2, 2, 2}, {3, 2, 2}, {2, 3, 2}, lo, hi));
+  // A diagonal sliver whose bounding box contains the box but which passes beside its corner:
+  // the plane x + y = 2.5 misses [0,1]^2 (max x + y = 2).
+  EXPECT_FALSE(triangle_overlaps_box({2.5f, 0, -1}, {0, 2.5f, -1}, {0, 2.5f, 2}, {-1, -1, -1}, hi));
+  // Touching a face counts (closed sets).
+  EXPECT_TRUE(triangle_overlaps_box({1, 0.2f, 0.2f}, {2, 0.2f, 0.2f}, {1, 0.8f, 0.8f}, lo, hi));
+}
+
+namespace {
+
+struct Walk {
+  std::vector<int> depth;       // per node
+  std::vector<std::set<std::uint32_t>> leaf_refs;  // per node (leaves only)
+};
+
+Walk walk(const Octree& t) {
+  Walk w;
+  w.depth.assign(t.nodes.size(), -1);
+  w.leaf_refs.resize(t.nodes.size());
+  w.depth[0] = 0;
+  std::vector<std::uint32_t> todo{0};
+  while (!todo.empty()) {
+    const std::uint32_t i = todo.back();
+    todo.pop_back();
+    const OctreeNode& n = t.nodes[i];
+    if (n.is_leaf()) {
+      w.leaf_refs[i].insert(t.refs.begin() + n.first, t.refs.begin() + n.first + n.count());
+      continue;
+    }
+    EXPECT_NE(n.mask & 0xffu, 0u) << "internal node without children";
+    const glm::vec4 c = t.cells[i];
+    for (unsigned k = 0; k < 8; ++k) {
+      if (!(n.mask & (1u << k))) continue;
+      const std::uint32_t child = n.first + static_cast<std::uint32_t>(std::popcount(n.mask & ((1u << k) - 1u)));
+      EXPECT_LT(child, t.nodes.size());
+      // The child's cell is octant k of the parent's.
+      const glm::vec4 cc = t.cells[child];
+      EXPECT_FLOAT_EQ(cc.w, c.w * 0.5f);
+      for (int a = 0; a < 3; ++a)
+        EXPECT_FLOAT_EQ(cc[a], c[a] + ((k >> a) & 1u ? c.w * 0.5f : 0.0f));
+      w.depth[child] = w.depth[i] + 1;
+      todo.push_back(child);
+    }
+  }
+  return w;
+}
+
+}  // namespace
+
+TEST(Octree, LeavesReferenceExactlyTheTrianglesTouchingTheirCell) {
+  Mesh mesh = shapes::torus(2.0f, 0.6f, 48, 24);
+  // Two degenerate faces: never inserted.
+  mesh.triangles.push_back({0, 0, 1});
+  mesh.triangles.push_back({0, 1, 1});
+  const OctreeParams params{6, 4};
+  const Octree t = build_octree(mesh, params);
+  const Walk w = walk(t);
+  const auto degenerate = degenerate_faces(mesh);
+  std::vector<int> seen(mesh.triangles.size(), 0);
+  std::size_t leaves = 0;
+  for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+    ASSERT_GE(w.depth[i], 0) << "node " << i << " is not reachable";
+    EXPECT_LE(w.depth[i], params.max_depth);
+    if (!t.nodes[i].is_leaf()) continue;
+    ++leaves;
+    if (w.depth[i] < params.max_depth) {
+      EXPECT_LE(t.nodes[i].count(), 4u);
+    }
+    const glm::vec3 lo(t.cells[i]), hi = lo + glm::vec3(t.cells[i].w);
+    const glm::vec3 pad(t.cells[i].w * 1e-3f);
+    for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f) {
+      const auto& tri = mesh.triangles[f];
+      const glm::vec3 a = mesh.positions[tri[0]], b = mesh.positions[tri[1]], c = mesh.positions[tri[2]];
+      const bool referenced = w.leaf_refs[i].count(f) > 0;
+      if (referenced) {
+        ++seen[f];
+        EXPECT_FALSE(degenerate[f]);
+        EXPECT_TRUE(triangle_overlaps_box(a, b, c, lo - pad, hi + pad)) << "face " << f;
+      } else if (!degenerate[f]) {
+        // Not referenced: then it does not reach into the cell (shrunk against rounding).
+        EXPECT_FALSE(triangle_overlaps_box(a, b, c, lo + pad, hi - pad)) << "face " << f;
+      }
+    }
+  }
+  EXPECT_EQ(leaves, t.leaf_count);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+    EXPECT_EQ(seen[f] > 0, !degenerate[f]) << "face " << f;
+  EXPECT_EQ(t.inserted_triangles, mesh.triangles.size() - 2);
+  EXPECT_GT(t.depth, 2);
+}
+
+TEST(Octree, RejectsBadParameters) {
+  const Mesh mesh = shapes::icosphere(1.0f, 1);
+  EXPECT_THROW(build_octree(mesh, {0, 8}), InputError);
+  EXPECT_THROW(build_octree(mesh, {17, 8}), InputError);
+  EXPECT_THROW(build_octree(mesh, {8, 0}), InputError);
+}
