@@ -19,9 +19,11 @@ packages=(
   libembree-dev libtbb-dev
   # CLI, logging, tests, benchmarks
   libcli11-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
-  # test data: CGAL's mesh data set (data.tar.gz); headers only used by the bench helper
+  # test data: CGAL's mesh data set (data.tar.gz)
   libcgal-demo
 )
+# Node.js runs the Khronos glTF validator in the tests; keep a newer one if the machine has it.
+if ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
 
 if [ "${1:-}" = "--bench" ]; then
   packages+=(libcgal-dev meshlab xvfb xauth)
@@ -30,3 +32,9 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${packages[@]}"
+
+# The Khronos glTF validator (npm package gltf-validator, pinned in its package.json).
+here="$(cd "$(dirname "$0")/.." && pwd)"
+if [ ! -d "$here/tools/gltf-validator/node_modules/gltf-validator" ]; then
+  npm install --prefix "$here/tools/gltf-validator" --no-package-lock --no-audit --no-fund --loglevel=error
+fi
