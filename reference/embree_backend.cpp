@@ -99,7 +99,7 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The rays of one point in Embree's packet layout for K = 1, 4, 8, 16.
+// Embree's packet types and calls for K = 4, 8, 16 rays (K = 1 uses rtcIntersect1).
 template <int K> struct Packet;
 template <> struct Packet<4> {
   using Type = RTCRayHit4;
