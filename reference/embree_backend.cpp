@@ -99,7 +99,7 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The rays of one point in Embree's packet layout for K = 1, 4, 8, 16.
+// Embree's packet types and calls for K = 4, 8, 16 rays (K = 1 uses rtcIntersect1).
 template <int K> struct Packet;
 template <> struct Packet<4> {
   using Type = RTCRayHit4;
@@ -146,6 +146,13 @@ struct EmbreeBackend::Impl {
 
   void build_scene();
   void refit();
+  // Forgets the geometry after a failure: compute() then asks for set_mesh.
+  void drop_mesh() {
+    geometry.reset();
+    scene.reset();
+    vertex_buffer = nullptr;
+    mesh = Mesh{};
+  }
   void trace_range(const SdfQuery& query, const SdfOptions& sdf,
                    std::span<const ConeRay> rays, std::atomic<std::size_t>& next,
                    std::size_t chunk, RawSdf& out) const;
@@ -342,9 +349,13 @@ EmbreeBackend::EmbreeBackend(EmbreeOptions options) : impl_(std::make_unique<Imp
   impl_->options = options;
   impl_->threads = options.threads != 0 ? options.threads
                                         : std::max(1u, std::thread::hardware_concurrency());
-  impl_->device.reset(rtcNewDevice(nullptr));
+  impl_->device.reset(
+      rtcNewDevice(options.device_config.empty() ? nullptr : options.device_config.c_str()));
   if (!impl_->device) {
     const RTCError code = rtcGetDeviceError(nullptr);
+    if (!options.device_config.empty())
+      throw DeviceError("could not start Embree with the device configuration '" +
+                        options.device_config + "' (" + error_name(code) + ")");
     throw DeviceError(std::string("could not start Embree (") + error_name(code) +
                       "); the CPU may lack the SSE2 support Embree needs");
   }
@@ -374,9 +385,7 @@ void EmbreeBackend::set_mesh(const Mesh& mesh) {
   try {
     impl_->build_scene();
   } catch (...) {
-    impl_->geometry.reset();
-    impl_->scene.reset();
-    impl_->mesh = Mesh{};
+    impl_->drop_mesh();
     throw;
   }
   impl_->build_ms = milliseconds_since(start);
@@ -392,12 +401,17 @@ void EmbreeBackend::update_positions(std::span<const glm::vec3> positions) {
   validate_mesh(moved, "the positions given to the Embree backend");
   const auto start = std::chrono::steady_clock::now();
   impl_->mesh.positions = std::move(moved.positions);
-  // A triangle that became degenerate (or stopped being one) changes the primitive set, which
-  // a refit cannot express: rebuild then.
-  if (degenerate_faces(impl_->mesh) != impl_->degenerate)
-    impl_->build_scene();
-  else
-    impl_->refit();
+  try {
+    // A triangle that became degenerate (or stopped being one) changes the primitive set,
+    // which a refit cannot express: rebuild then.
+    if (degenerate_faces(impl_->mesh) != impl_->degenerate)
+      impl_->build_scene();
+    else
+      impl_->refit();
+  } catch (...) {
+    impl_->drop_mesh();
+    throw;
+  }
   impl_->build_ms = milliseconds_since(start);
 }
 

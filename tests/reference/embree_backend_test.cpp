@@ -66,15 +66,25 @@ bool all_finite(const std::vector<float>& v) {
 }  // namespace
 
 TEST(EmbreeBackend, NamesItselfAndItsDevice) {
-  EmbreeBackend b(EmbreeOptions{3, 8});
+  EmbreeBackend b(EmbreeOptions{.threads = 3});
   EXPECT_EQ(b.name(), "embree");
   EXPECT_EQ(b.thread_count(), 3u);
   EXPECT_NE(b.device_name().find("Embree 3."), std::string::npos) << b.device_name();
   EXPECT_NE(b.device_name().find("3 threads"), std::string::npos) << b.device_name();
 }
 
+TEST(EmbreeBackend, ABadDeviceConfigurationIsADeviceError) {
+  try {
+    EmbreeBackend b(EmbreeOptions{.device_config = "threads=many"});
+    FAIL() << "no error";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("'threads=many'"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(EmbreeBackend(EmbreeOptions{.device_config = "threads=1"}));
+}
+
 TEST(EmbreeBackend, RejectsMisuse) {
-  EXPECT_THROW(EmbreeBackend(EmbreeOptions{1, 5}), InputError);
+  EXPECT_THROW(EmbreeBackend(EmbreeOptions{.packet_size = 5}), InputError);
   EmbreeBackend b;
   const Mesh m = shapes::icosphere(1.0f, 1);
   EXPECT_THROW(b.compute(make_query(m, SdfDomain::Vertex), {}), Error);
@@ -110,8 +120,8 @@ TEST(EmbreeBackend, DeterministicForAnyThreadCountAndRun) {
     for (SdfDomain domain : {SdfDomain::Vertex, SdfDomain::Face}) {
       SdfOptions o;
       o.domain = domain;
-      const RawSdf one = run(m, o, {1, packet});
-      EmbreeBackend many(EmbreeOptions{7, packet});
+      const RawSdf one = run(m, o, {.threads = 1, .packet_size = packet});
+      EmbreeBackend many(EmbreeOptions{.threads = 7, .packet_size = packet});
       const RawSdf a = run(many, m, o);
       const RawSdf b = many.compute(make_query(m, domain), o);
       ASSERT_EQ(one.values.size(), a.values.size());
@@ -123,11 +133,20 @@ TEST(EmbreeBackend, DeterministicForAnyThreadCountAndRun) {
   }
 }
 
+TEST(EmbreeBackend, DeterministicWhateverThreadsBuildTheBvh) {
+  // Large enough (37k triangles) for Embree's builder to split the work over its threads.
+  const Mesh m = shapes::torus(2.0f, 0.5f, 192, 96);
+  const RawSdf serial = run(m, {}, {.threads = 1, .device_config = "threads=1"});
+  const RawSdf parallel = run(m, {}, {.threads = 4});
+  EXPECT_EQ(0, std::memcmp(serial.values.data(), parallel.values.data(), serial.values.size() * sizeof(float)));
+  EXPECT_EQ(serial.kept_rays, parallel.kept_rays);
+}
+
 TEST(EmbreeBackend, PacketSizesAgreeToRounding) {
   const Mesh m = shapes::torus(2.0f, 0.5f, 48, 16);
-  const RawSdf single = run(m, {}, {2, 1});
+  const RawSdf single = run(m, {}, {.threads = 2, .packet_size = 1});
   for (int packet : {4, 8, 16}) {
-    const RawSdf p = run(m, {}, {2, packet});
+    const RawSdf p = run(m, {}, {.threads = 2, .packet_size = packet});
     EXPECT_LT(test::quantile_relative_difference(p.values, single.values, 1.0), 1e-5) << packet;
   }
 }

@@ -26,14 +26,18 @@ struct EmbreeOptions {
   unsigned threads = 0;
   // Rays handed to Embree per call: 1 (rtcIntersect1), 4, 8 or 16 (rtcIntersect4/8/16 packets
   // of one point's rays). Values differ from one packet size to another only by rounding in
-  // Embree's intersectors; for a fixed packet size they are deterministic.
+  // Embree's intersectors; for a fixed packet size they are deterministic. Packets of 8 traced
+  // about 12% more rays per CPU-second than single rays on armadillo (2.75 vs 2.44 M/s).
   int packet_size = 8;
+  // Embree's device configuration (rtcNewDevice), e.g. "threads=2" to bound the threads
+  // Embree's BVH builder uses. Empty: Embree's defaults.
+  std::string device_config{};
 };
 
 class EmbreeBackend final : public SdfBackend {
 public:
-  // Creates the Embree device. Throws DeviceError when Embree cannot start (unsupported CPU)
-  // and InputError for options out of range.
+  // Creates the Embree device. Throws DeviceError when Embree cannot start (a malformed
+  // device_config, an unsupported CPU) and InputError for options out of range.
   explicit EmbreeBackend(EmbreeOptions options = {});
   ~EmbreeBackend() override;
 
