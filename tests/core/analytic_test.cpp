@@ -10,21 +10,6 @@
 
 using namespace sdfkit;
 
-namespace {
-// On a sphere of radius R a ray at angle theta to the inward normal travels 2 R cos(theta);
-// under the paper's rule only theta <= 45 degrees passes (the exit normal makes an angle
-// 180 - 2 theta with the start normal); under CGAL's rule every ray leaves and passes.
-float sphere_expected(float radius, const SdfOptions& o) {
-  std::vector<float> d, w;
-  for (const ConeRay& r : cone_rays(o.rays, o.cone_degrees)) {
-    if (o.false_hit == FalseHitRule::Paper && r.theta > float(M_PI / 4)) continue;
-    d.push_back(2 * radius * std::cos(r.theta));
-    w.push_back(r.weight);
-  }
-  return gather(d, w).value;
-}
-}  // namespace
-
 TEST(Analytic, SphereMatchesTheClosedForm) {
   // Exact radial normals: at the defaults ray 17 of 30 lies at 44.9 degrees, 0.1 degree from
   // the sphere's 45-degree cut-off, so the closed form needs the true normal, not a facet's.
@@ -35,7 +20,7 @@ TEST(Analytic, SphereMatchesTheClosedForm) {
     SdfOptions o;
     o.false_hit = rule;
     const RawSdf raw = test::analytic_sdf(q, o, [](const glm::vec3& p) { return shapes::sphere_sdf(p, 3.0f); }, 6.0f);
-    const float expected = sphere_expected(3.0f, o);
+    const float expected = test::sphere_closed_form(3.0f, o);
     for (std::size_t i = 0; i < q.size(); ++i) {
       EXPECT_NEAR(raw.values[i], expected, 1e-3f * expected) << i;
       EXPECT_GT(raw.kept_rays[i], 0u);
@@ -45,7 +30,7 @@ TEST(Analytic, SphereMatchesTheClosedForm) {
   SdfOptions paper;
   SdfOptions cgal;
   cgal.false_hit = FalseHitRule::Cgal;
-  EXPECT_GT(sphere_expected(3, paper), sphere_expected(3, cgal));
+  EXPECT_GT(test::sphere_closed_form(3, paper), test::sphere_closed_form(3, cgal));
 }
 
 TEST(Analytic, SlabMatchesTheClosedForm) {

@@ -15,17 +15,6 @@ using namespace sdfkit;
 
 namespace {
 
-// On a sphere of radius R a ray at angle theta to the inward normal travels 2 R cos(theta);
-// the paper's rule keeps theta <= 45 degrees, CGAL's rule keeps every ray.
-float sphere_expected(float radius, const SdfOptions& o) {
-  std::vector<float> d, w;
-  for (const ConeRay& r : cone_rays(o.rays, o.cone_degrees)) {
-    if (o.false_hit == FalseHitRule::Paper && r.theta > float(M_PI / 4)) continue;
-    d.push_back(2 * radius * std::cos(r.theta));
-    w.push_back(r.weight);
-  }
-  return gather(d, w).value;
-}
 
 float median(std::vector<float> v) { return median_of(v); }
 
@@ -40,7 +29,7 @@ TEST(OpenClAnalytic, SphereMatchesTheClosedForm) {
     SdfOptions o;
     o.false_hit = rule;
     const SdfField f = compute_sdf(backend, mesh, o);
-    const float expected = sphere_expected(radius, o);
+    const float expected = test::sphere_closed_form(radius, o);
     EXPECT_EQ(f.filled_count, 0u);
     // Facet normals sit next to the paper rule's 45-degree cut-off (ray 17 of 30 at 44.9
     // degrees), so that rule is checked by the median; CGAL's rule point by point.

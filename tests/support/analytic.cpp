@@ -64,6 +64,16 @@ RawSdf analytic_sdf(const SdfQuery& query, const SdfOptions& options, const Impl
   return raw;
 }
 
+float sphere_closed_form(float radius, const SdfOptions& o) {
+  std::vector<float> d, w;
+  for (const ConeRay& r : cone_rays(o.rays, o.cone_degrees)) {
+    if (o.false_hit == FalseHitRule::Paper && r.theta > static_cast<float>(M_PI / 4)) continue;
+    d.push_back(2.0f * radius * std::cos(r.theta));
+    w.push_back(r.weight);
+  }
+  return gather(d, w).value;
+}
+
 std::string data_mesh(const std::string& name) { return std::string(SDFKIT_TEST_DATA_DIR) + "/" + name; }
 
 }  // namespace sdfkit::test

@@ -18,6 +18,12 @@ using ImplicitFn = std::function<float(const glm::vec3&)>;
 RawSdf analytic_sdf(const SdfQuery& query, const SdfOptions& options, const ImplicitFn& sdf,
                     float scale);
 
+// The estimator's exact value on a sphere of radius R, per point, with exact normals: a ray at
+// angle theta to the inward normal travels 2 R cos(theta); under the paper's rule only
+// theta <= 45 degrees passes (the exit normal makes 180 - 2 theta with the start normal), under
+// CGAL's rule every ray leaves the solid and passes.
+float sphere_closed_form(float radius, const SdfOptions& options);
+
 // Path of a mesh from CGAL's data set extracted into the build tree ("cow.off").
 std::string data_mesh(const std::string& name);
 
