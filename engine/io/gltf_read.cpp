@@ -1,0 +1,412 @@
+// glTF 2.0 reader (.gltf with external or data-URI buffers, .glb) through tinygltf. Every
+// triangle primitive of the default scene (all root nodes when there is none) is placed by its
+// node's world transform; the parsed model is kept for write-back.
+
+#include "gltf_model.hpp"
+#include "readers.hpp"
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat4x4.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <sstream>
+
+namespace sdfkit::io::detail {
+
+bool keep_image_bytes(tinygltf::Image* image, int, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void*) {
+  // Images inside a bufferView stay in their buffer; others keep their encoded bytes so that
+  // the writer can embed them.
+  if (image->bufferView < 0 && bytes != nullptr && size > 0)
+    image->image.assign(bytes, bytes + size);
+  image->width = image->height = image->component = image->bits = -1;
+  image->as_is = true;
+  return true;
+}
+
+namespace {
+
+// First non-empty line of a tinygltf message, trimmed.
+std::string first_line(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    std::size_t b = 0;
+    while (b < line.size() && std::isspace(static_cast<unsigned char>(line[b]))) ++b;
+    if (b < line.size()) return line.substr(b);
+  }
+  return "";
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line))
+    if (!first_line(line).empty()) out.push_back(first_line(line));
+  return out;
+}
+
+// Reads accessor data as numbers: the view of one accessor with every check a malformed file
+// needs (indices in range, reads inside their buffers).
+class AccessorReader {
+public:
+  AccessorReader(const std::string& path, const tinygltf::Model& model) : path_(path), m_(model) {}
+
+  // `components` values per element, as floats (normalized integers mapped as the glTF spec
+  // says, plain integers converted).
+  std::vector<float> floats(int index, int components, const char* what) const {
+    const tinygltf::Accessor& a = accessor(index, what);
+    if (tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type)) != components)
+      fail(path_, std::string(what) + " accessor " + std::to_string(index) +
+                      " has the wrong type (expected " + std::to_string(components) +
+                      " components)");
+    std::vector<float> out;
+    read_base(a, index, components, what, out);
+    apply_sparse(a, index, components, what, out);
+    return out;
+  }
+
+  // Vertex indices as uint32.
+  std::vector<std::uint32_t> indices(int index) const {
+    const tinygltf::Accessor& a = accessor(index, "index");
+    if (a.type != TINYGLTF_TYPE_SCALAR ||
+        (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+         a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+         a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+      fail(path_, "index accessor " + std::to_string(index) +
+                      " is not a SCALAR of unsigned byte, short or int");
+    std::vector<double> values;
+    read_base(a, index, 1, "index", values);
+    apply_sparse(a, index, 1, "index", values);
+    std::vector<std::uint32_t> out(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) out[i] = static_cast<std::uint32_t>(values[i]);
+    return out;
+  }
+
+  const tinygltf::Accessor& accessor(int index, const char* what) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= m_.accessors.size())
+      fail(path_, std::string(what) + " accessor " + std::to_string(index) + " does not exist");
+    return m_.accessors[static_cast<std::size_t>(index)];
+  }
+
+private:
+  static std::size_t component_size(int type) {
+    const int s = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(type));
+    return s > 0 ? static_cast<std::size_t>(s) : 0;
+  }
+
+  static double decode(const unsigned char* p, int type, bool normalized) {
+    switch (type) {
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
+      case TINYGLTF_COMPONENT_TYPE_DOUBLE: { double v; std::memcpy(&v, p, 8); return v; }
+      case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        std::int8_t v; std::memcpy(&v, p, 1);
+        return normalized ? std::max(v / 127.0, -1.0) : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+      case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        std::int16_t v; std::memcpy(&v, p, 2);
+        return normalized ? std::max(v / 32767.0, -1.0) : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        std::uint16_t v; std::memcpy(&v, p, 2);
+        return normalized ? v / 65535.0 : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_INT: { std::int32_t v; std::memcpy(&v, p, 4); return v; }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        std::uint32_t v; std::memcpy(&v, p, 4);
+        return normalized ? v / 4294967295.0 : v;
+      }
+      default: return 0.0;
+    }
+  }
+
+  // The bytes of bufferView `view`, checked against its buffer.
+  const unsigned char* view_bytes(int view, std::size_t& length, std::size_t& stride,
+                                  int accessor_index, const char* what) const {
+    if (view < 0 || static_cast<std::size_t>(view) >= m_.bufferViews.size())
+      fail(path_, std::string(what) + " accessor " + std::to_string(accessor_index) +
+                      " uses bufferView " + std::to_string(view) + " which does not exist");
+    const tinygltf::BufferView& bv = m_.bufferViews[static_cast<std::size_t>(view)];
+    if (bv.buffer < 0 || static_cast<std::size_t>(bv.buffer) >= m_.buffers.size())
+      fail(path_, "bufferView " + std::to_string(view) + " uses buffer " +
+                      std::to_string(bv.buffer) + " which does not exist");
+    const tinygltf::Buffer& b = m_.buffers[static_cast<std::size_t>(bv.buffer)];
+    if (bv.byteOffset > b.data.size() || bv.byteLength > b.data.size() - bv.byteOffset)
+      fail(path_, "bufferView " + std::to_string(view) + " reaches past the end of buffer " +
+                      std::to_string(bv.buffer) + " (" + std::to_string(b.data.size()) +
+                      " bytes loaded)");
+    length = bv.byteLength;
+    stride = bv.byteStride;
+    return b.data.data() + bv.byteOffset;
+  }
+
+  // The accessor's own values (zeros without a bufferView, as the spec says), `out` resized
+  // only after the declared count has been checked against the data.
+  template <typename T>
+  void read_base(const tinygltf::Accessor& a, int index, int components, const char* what,
+                 std::vector<T>& out) const {
+    if (a.bufferView >= 0) {
+      read_into(a.bufferView, a.byteOffset, a.count, components, a.componentType, a.normalized,
+                index, what, out);
+      return;
+    }
+    if (!a.sparse.isSparse)
+      fail(path_, std::string(what) + " accessor " + std::to_string(index) +
+                      " has no data (no bufferView; compressed meshes are not supported)");
+    // Sparse on zeros: the sparse part carries the data; bound the zeros by a sane size.
+    if (a.count > (std::size_t{1} << 28))
+      fail(path_, std::string(what) + " accessor " + std::to_string(index) +
+                      " declares too many elements");
+    out.assign(a.count * static_cast<std::size_t>(components), T(0));
+  }
+
+  template <typename T>
+  void read_into(int view, std::size_t offset, std::size_t count, int components, int type,
+                 bool normalized, int accessor_index, const char* what,
+                 std::vector<T>& out) const {
+    const std::size_t csize = component_size(type);
+    if (csize == 0)
+      fail(path_, std::string(what) + " accessor " + std::to_string(accessor_index) +
+                      " has an unknown component type " + std::to_string(type));
+    std::size_t length = 0, stride = 0;
+    const unsigned char* base = view_bytes(view, length, stride, accessor_index, what);
+    const std::size_t element = csize * static_cast<std::size_t>(components);
+    if (stride == 0) stride = element;
+    if (stride < element)
+      fail(path_, std::string(what) + " accessor " + std::to_string(accessor_index) +
+                      " has a byteStride smaller than its element");
+    if (count > 0 && (offset > length || element > length - offset ||
+                      (count - 1) > (length - offset - element) / stride))
+      fail(path_, std::string(what) + " accessor " + std::to_string(accessor_index) +
+                      " reads past the end of bufferView " + std::to_string(view));
+    out.resize(count * static_cast<std::size_t>(components));
+    for (std::size_t i = 0; i < count; ++i) {
+      const unsigned char* e = base + offset + i * stride;
+      for (int k = 0; k < components; ++k)
+        out[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(k)] =
+            static_cast<T>(decode(e + static_cast<std::size_t>(k) * csize, type, normalized));
+    }
+  }
+
+  template <typename T>
+  void apply_sparse(const tinygltf::Accessor& a, int index, int components, const char* what,
+                    std::vector<T>& out) const {
+    if (!a.sparse.isSparse) return;
+    if (a.sparse.count < 0 || static_cast<std::size_t>(a.sparse.count) > a.count)
+      fail(path_, std::string(what) + " accessor " + std::to_string(index) +
+                      " has an invalid sparse count");
+    const auto n = static_cast<std::size_t>(a.sparse.count);
+    std::vector<double> where;
+    read_into(a.sparse.indices.bufferView, static_cast<std::size_t>(a.sparse.indices.byteOffset),
+              n, 1, a.sparse.indices.componentType, false, index, what, where);
+    std::vector<T> values;
+    read_into(a.sparse.values.bufferView, static_cast<std::size_t>(a.sparse.values.byteOffset), n,
+              components, a.componentType, a.normalized, index, what, values);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!(where[i] >= 0.0) || where[i] >= static_cast<double>(a.count))
+        fail(path_, std::string(what) + " accessor " + std::to_string(index) +
+                        " has a sparse index out of range");
+      const auto target = static_cast<std::size_t>(where[i]);
+      for (int k = 0; k < components; ++k)
+        out[target * static_cast<std::size_t>(components) + static_cast<std::size_t>(k)] =
+            values[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(k)];
+    }
+  }
+
+  const std::string& path_;
+  const tinygltf::Model& m_;
+};
+
+// The node's local transform: its matrix, or translation * rotation * scale.
+glm::dmat4 local_transform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    glm::dmat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = node.matrix[static_cast<std::size_t>(c * 4 + r)];
+    return m;
+  }
+  glm::dmat4 t(1.0), r(1.0), s(1.0);
+  if (node.translation.size() == 3)
+    t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+  if (node.rotation.size() == 4) {
+    const glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
+    r = glm::mat4_cast(glm::normalize(q));
+  }
+  if (node.scale.size() == 3) {
+    s[0][0] = node.scale[0];
+    s[1][1] = node.scale[1];
+    s[2][2] = node.scale[2];
+  }
+  return t * r * s;
+}
+
+const char* mode_name(int mode) {
+  switch (mode) {
+    case TINYGLTF_MODE_POINTS: return "POINTS";
+    case TINYGLTF_MODE_LINE: return "LINES";
+    case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
+    case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
+    default: return "unknown-mode";
+  }
+}
+
+// Walks the scene and appends every triangle primitive instance to the raw mesh.
+class SceneWalker {
+public:
+  SceneWalker(const std::string& path, GltfSource& source, RawMesh& out)
+      : path_(path), src_(source), m_(source.model), out_(out), reader_(path, source.model) {}
+
+  void walk() {
+    std::vector<int> roots;
+    if (m_.defaultScene >= 0 && static_cast<std::size_t>(m_.defaultScene) < m_.scenes.size()) {
+      roots = m_.scenes[static_cast<std::size_t>(m_.defaultScene)].nodes;
+    } else {
+      std::vector<std::uint8_t> is_child(m_.nodes.size(), 0);
+      for (const tinygltf::Node& n : m_.nodes)
+        for (int c : n.children)
+          if (c >= 0 && static_cast<std::size_t>(c) < m_.nodes.size())
+            is_child[static_cast<std::size_t>(c)] = 1;
+      for (std::size_t i = 0; i < m_.nodes.size(); ++i)
+        if (!is_child[i]) roots.push_back(static_cast<int>(i));
+    }
+    on_path_.assign(m_.nodes.size(), 0);
+    for (int r : roots) visit(r, glm::dmat4(1.0));
+    for (const auto& [what, count] : skipped_)
+      out_.warnings.push_back("skipped " + std::to_string(count) + " " + what);
+  }
+
+private:
+  void visit(int index, const glm::dmat4& parent) {
+    if (index < 0 || static_cast<std::size_t>(index) >= m_.nodes.size())
+      fail(path_, "the scene refers to node " + std::to_string(index) + " which does not exist");
+    const auto i = static_cast<std::size_t>(index);
+    if (on_path_[i]) fail(path_, "node " + std::to_string(index) + " is its own ancestor (cycle)");
+    on_path_[i] = 1;
+    const tinygltf::Node& node = m_.nodes[i];
+    const glm::dmat4 world = parent * local_transform(node);
+    if (node.mesh >= 0) {
+      if (static_cast<std::size_t>(node.mesh) >= m_.meshes.size())
+        fail(path_, "node " + std::to_string(index) + " uses mesh " + std::to_string(node.mesh) +
+                        " which does not exist");
+      const tinygltf::Mesh& mesh = m_.meshes[static_cast<std::size_t>(node.mesh)];
+      for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
+        add_primitive(index, node.mesh, static_cast<int>(p), world);
+    }
+    for (int c : node.children) visit(c, world);
+    on_path_[i] = 0;
+  }
+
+  void add_primitive(int node, int mesh_index, int prim_index, const glm::dmat4& world) {
+    const tinygltf::Primitive& prim =
+        m_.meshes[static_cast<std::size_t>(mesh_index)].primitives[static_cast<std::size_t>(prim_index)];
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      ++skipped_[std::string(mode_name(mode)) + " primitives"];
+      return;
+    }
+    const auto pos_it = prim.attributes.find("POSITION");
+    if (pos_it == prim.attributes.end()) {
+      ++skipped_["triangle primitives without POSITION"];
+      return;
+    }
+    const std::string where = "mesh " + std::to_string(mesh_index) + " primitive " +
+                              std::to_string(prim_index);
+    const std::vector<float> xyz = reader_.floats(pos_it->second, 3, "POSITION");
+    const std::size_t count = xyz.size() / 3;
+    if (count == 0) {
+      ++skipped_["triangle primitives without vertices"];
+      return;
+    }
+    if (out_.positions.size() + count > UINT32_MAX) fail(path_, "too many vertices");
+    const auto first = static_cast<std::uint32_t>(out_.positions.size());
+
+    for (std::size_t v = 0; v < count; ++v) {
+      const glm::dvec4 p = world * glm::dvec4(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2], 1.0);
+      out_.positions.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y),
+                                  static_cast<float>(p.z));
+    }
+
+    std::vector<std::uint32_t> idx;
+    if (prim.indices >= 0) {
+      idx = reader_.indices(prim.indices);
+      for (std::uint32_t k : idx)
+        if (k >= count)
+          fail(path_, where + " uses vertex " + std::to_string(k) + " but its POSITION has " +
+                          std::to_string(count) + " vertices");
+    } else {
+      idx.resize(count);
+      for (std::size_t k = 0; k < count; ++k) idx[k] = static_cast<std::uint32_t>(k);
+    }
+
+    // A mirroring transform (negative determinant) flips the winding; glTF says to flip back.
+    const bool flip = glm::determinant(glm::dmat3(world)) < 0.0;
+    auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+      if (flip) std::swap(b, c);
+      out_.triangles.push_back(Triangle{first + a, first + b, first + c});
+    };
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      for (std::size_t t = 0; t + 2 < idx.size(); t += 3) emit(idx[t], idx[t + 1], idx[t + 2]);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      for (std::size_t t = 0; t + 2 < idx.size(); ++t) {
+        if (t % 2 == 0) emit(idx[t], idx[t + 1], idx[t + 2]);
+        else emit(idx[t + 1], idx[t], idx[t + 2]);
+      }
+    } else {
+      for (std::size_t t = 1; t + 1 < idx.size(); ++t) emit(idx[t], idx[t + 1], idx[0]);
+    }
+    src_.instances.push_back(GltfPrimitiveInstance{node, mesh_index, prim_index, first,
+                                                   static_cast<std::uint32_t>(count)});
+  }
+
+  const std::string& path_;
+  GltfSource& src_;
+  const tinygltf::Model& m_;
+  RawMesh& out_;
+  AccessorReader reader_;
+  std::vector<std::uint8_t> on_path_;
+  std::map<std::string, std::size_t> skipped_;
+};
+
+}  // namespace
+
+RawMesh read_gltf(const std::string& path, bool binary) {
+  auto source = std::make_shared<GltfSource>();
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(&keep_image_bytes, nullptr);
+  loader.SetPreserveImageChannels(true);
+  std::string err, warn;
+  const bool ok = binary ? loader.LoadBinaryFromFile(&source->model, &err, &warn, path)
+                         : loader.LoadASCIIFromFile(&source->model, &err, &warn, path);
+  if (!ok) {
+    std::string problem = first_line(err);
+    if (problem.empty()) problem = first_line(warn);
+    if (problem.empty()) problem = "not a valid glTF file";
+    fail(path, "invalid glTF: " + problem);
+  }
+  RawMesh out;
+  for (const std::string& w : lines_of(warn)) out.warnings.push_back(w);
+  for (const std::string& ext : source->model.extensionsRequired) {
+    if (ext != "KHR_mesh_quantization" && ext != "KHR_materials_unlit" &&
+        ext != "KHR_texture_transform")
+      fail(path, "requires the glTF extension " + ext + ", which sdfkit cannot read");
+  }
+  SceneWalker(path, *source, out).walk();
+  if (out.triangles.empty() && !source->instances.empty())
+    fail(path, "the scene's triangle primitives have no triangles");
+  if (source->instances.empty())
+    fail(path, out.warnings.empty() ? std::string("the scene has no triangle primitives")
+                                    : "the scene has no triangle primitives (" +
+                                          out.warnings.back() + ")");
+  out.source = std::move(source);
+  return out;
+}
+
+}  // namespace sdfkit::io::detail

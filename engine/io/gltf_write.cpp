@@ -1,0 +1,256 @@
+// glTF/glb writer: the input glTF written back with _SDF, _SDF_NORMALIZED and COLOR_0 on every
+// drawn triangle primitive, or a fresh minimal glTF for other inputs.
+//
+// Buffers: the output has a single buffer (all input buffers concatenated, 8-byte aligned, the
+// new data appended), stored as the BIN chunk of a .glb or as a base64 data URI in a .gltf, so
+// either output is one self-contained file. Images that were files or data URIs next to the
+// input are embedded as data URIs; images inside a bufferView stay there.
+
+#include "gltf_model.hpp"
+#include "writers.hpp"
+
+#include "sdfkit/core/error.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <ostream>
+#include <utility>
+
+namespace sdfkit::io::detail {
+namespace {
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  static constexpr char kTable[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const std::uint32_t v = (bytes[i] << 16) | (bytes[i + 1] << 8) | bytes[i + 2];
+    out += kTable[(v >> 18) & 63];
+    out += kTable[(v >> 12) & 63];
+    out += kTable[(v >> 6) & 63];
+    out += kTable[v & 63];
+  }
+  if (i < bytes.size()) {
+    const std::uint32_t v = (bytes[i] << 16) | (i + 1 < bytes.size() ? bytes[i + 1] << 8 : 0);
+    out += kTable[(v >> 18) & 63];
+    out += kTable[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kTable[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+std::string mime_for(const tinygltf::Image& image, const std::string& filename) {
+  if (!image.mimeType.empty()) return image.mimeType;
+  std::string ext = filename.substr(filename.find_last_of('.') + 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (ext == "png") return "image/png";
+  if (ext == "jpg" || ext == "jpeg") return "image/jpeg";
+  if (ext == "bmp") return "image/bmp";
+  if (ext == "gif") return "image/gif";
+  return "application/octet-stream";
+}
+
+// tinygltf image writer: embeds the encoded bytes kept by keep_image_bytes as a data URI;
+// images whose bytes could not be loaded keep their original uri.
+bool embed_image(const std::string*, const std::string* filename, const tinygltf::Image* image,
+                 bool, std::string* out_uri, void*) {
+  if (image->image.empty()) return false;
+  *out_uri = "data:" + mime_for(*image, filename ? *filename : std::string()) + ";base64," +
+             base64(image->image);
+  return true;
+}
+
+// Appends float data as a new bufferView + accessor of buffer 0; returns the accessor index.
+class BufferAppender {
+public:
+  explicit BufferAppender(tinygltf::Model& model) : m_(model) {}
+
+  int add_floats(const float* data, std::size_t count, int type, int target, bool min_max) {
+    const int comps = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(type));
+    return add(data, count, comps, TINYGLTF_COMPONENT_TYPE_FLOAT, type, target, min_max);
+  }
+
+  int add_indices(const std::uint32_t* data, std::size_t count) {
+    return add(data, count, 1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+               TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
+  }
+
+private:
+  template <typename T>
+  int add(const T* data, std::size_t count, int comps, int component_type, int type, int target,
+          bool min_max) {
+    std::vector<unsigned char>& bytes = m_.buffers[0].data;
+    bytes.resize((bytes.size() + 7) / 8 * 8, 0);  // 8-byte aligned views
+    const std::size_t offset = bytes.size();
+    const std::size_t length = count * static_cast<std::size_t>(comps) * sizeof(T);
+    bytes.resize(offset + length);
+    if (length > 0) std::memcpy(bytes.data() + offset, data, length);
+
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = offset;
+    view.byteLength = length;
+    view.target = target;
+    m_.bufferViews.push_back(view);
+
+    tinygltf::Accessor a;
+    a.bufferView = static_cast<int>(m_.bufferViews.size() - 1);
+    a.byteOffset = 0;
+    a.componentType = component_type;
+    a.count = count;
+    a.type = type;
+    if (min_max && count > 0) {
+      a.minValues.assign(static_cast<std::size_t>(comps), 0.0);
+      a.maxValues.assign(static_cast<std::size_t>(comps), 0.0);
+      for (int k = 0; k < comps; ++k) {
+        double lo = static_cast<double>(data[k]), hi = lo;
+        for (std::size_t i = 1; i < count; ++i) {
+          const double v = static_cast<double>(data[i * static_cast<std::size_t>(comps) + static_cast<std::size_t>(k)]);
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+        a.minValues[static_cast<std::size_t>(k)] = lo;
+        a.maxValues[static_cast<std::size_t>(k)] = hi;
+      }
+    }
+    m_.accessors.push_back(a);
+    return static_cast<int>(m_.accessors.size() - 1);
+  }
+
+  tinygltf::Model& m_;
+};
+
+// All buffers become buffer 0 (no uri): the BIN chunk of a glb or one data URI in a .gltf.
+void merge_buffers(tinygltf::Model& model) {
+  if (model.buffers.empty()) {
+    model.buffers.emplace_back();
+    return;
+  }
+  std::vector<std::size_t> base(model.buffers.size());
+  tinygltf::Buffer merged;
+  merged.name = model.buffers[0].name;
+  for (std::size_t b = 0; b < model.buffers.size(); ++b) {
+    merged.data.resize((merged.data.size() + 7) / 8 * 8, 0);
+    base[b] = merged.data.size();
+    merged.data.insert(merged.data.end(), model.buffers[b].data.begin(),
+                       model.buffers[b].data.end());
+  }
+  for (tinygltf::BufferView& v : model.bufferViews) {
+    if (v.buffer >= 0 && static_cast<std::size_t>(v.buffer) < base.size()) {
+      v.byteOffset += base[static_cast<std::size_t>(v.buffer)];
+      v.buffer = 0;
+    }
+  }
+  model.buffers.assign(1, std::move(merged));
+}
+
+// Per-vertex data of one primitive instance: the values and their colours.
+struct PrimitiveData {
+  std::vector<float> raw, norm, rgb;
+};
+
+PrimitiveData slice(const OutputValues& values, std::uint32_t first, std::uint32_t count,
+                    bool color) {
+  PrimitiveData d;
+  d.raw.assign(values.raw.begin() + first, values.raw.begin() + first + count);
+  d.norm.assign(values.normalized.begin() + first, values.normalized.begin() + first + count);
+  if (color) {
+    d.rgb.resize(static_cast<std::size_t>(count) * 3);
+    for (std::size_t i = 0; i < count; ++i) {
+      const glm::vec3 c = colormap(d.norm[i]);
+      d.rgb[3 * i] = c.x;
+      d.rgb[3 * i + 1] = c.y;
+      d.rgb[3 * i + 2] = c.z;
+    }
+  }
+  return d;
+}
+
+void add_sdf_attributes(BufferAppender& appender, tinygltf::Primitive& prim,
+                        const PrimitiveData& d, std::size_t count) {
+  prim.attributes["_SDF"] = appender.add_floats(d.raw.data(), count, TINYGLTF_TYPE_SCALAR,
+                                                TINYGLTF_TARGET_ARRAY_BUFFER, true);
+  prim.attributes["_SDF_NORMALIZED"] = appender.add_floats(
+      d.norm.data(), count, TINYGLTF_TYPE_SCALAR, TINYGLTF_TARGET_ARRAY_BUFFER, true);
+  if (!d.rgb.empty())
+    prim.attributes["COLOR_0"] = appender.add_floats(d.rgb.data(), count, TINYGLTF_TYPE_VEC3,
+                                                     TINYGLTF_TARGET_ARRAY_BUFFER, false);
+}
+
+tinygltf::Model write_back_model(const GltfSource& src, const OutputValues& values,
+                                 const WriteOptions& options, std::vector<std::string>& warnings) {
+  tinygltf::Model model = src.model;
+  merge_buffers(model);
+  BufferAppender appender(model);
+  std::map<std::pair<int, int>, bool> done;  // (mesh, primitive): first instance wins
+  std::size_t replaced_colors = 0;
+  for (const GltfPrimitiveInstance& inst : src.instances) {
+    if (!done.emplace(std::make_pair(inst.mesh, inst.primitive), true).second) continue;
+    tinygltf::Primitive& prim = model.meshes[static_cast<std::size_t>(inst.mesh)]
+                                    .primitives[static_cast<std::size_t>(inst.primitive)];
+    if (options.color && prim.attributes.count("COLOR_0")) ++replaced_colors;
+    add_sdf_attributes(appender, prim, slice(values, inst.first_vertex, inst.vertex_count, options.color),
+                       inst.vertex_count);
+  }
+  if (replaced_colors > 0)
+    warnings.push_back("replaced the existing COLOR_0 of " + std::to_string(replaced_colors) +
+                       " primitives with the SDF colours");
+  return model;
+}
+
+tinygltf::Model fresh_model(const Asset& asset, const OutputValues& values,
+                            const WriteOptions& options) {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "sdfkit";
+  model.buffers.emplace_back();
+  BufferAppender appender(model);
+  const std::size_t nv = asset.input_positions.size();
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  prim.attributes["POSITION"] =
+      appender.add_floats(&asset.input_positions[0].x, nv, TINYGLTF_TYPE_VEC3,
+                          TINYGLTF_TARGET_ARRAY_BUFFER, true);
+  prim.indices = appender.add_indices(asset.input_triangles.data()->data(),
+                                      asset.input_triangles.size() * 3);
+  add_sdf_attributes(appender, prim, slice(values, 0, static_cast<std::uint32_t>(nv), options.color), nv);
+  tinygltf::Mesh mesh;
+  mesh.primitives.push_back(std::move(prim));
+  model.meshes.push_back(std::move(mesh));
+  tinygltf::Node node;
+  node.mesh = 0;
+  model.nodes.push_back(std::move(node));
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  model.scenes.push_back(std::move(scene));
+  model.defaultScene = 0;
+  return model;
+}
+
+}  // namespace
+
+void write_gltf(std::ostream& out, bool binary, const Asset& asset, const OutputValues& values,
+                const WriteOptions& options, std::vector<std::string>& warnings) {
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  static_assert(sizeof(Triangle) == 3 * sizeof(std::uint32_t));
+  const auto* src = (asset.format == Format::Gltf || asset.format == Format::Glb)
+                        ? static_cast<const GltfSource*>(asset.source.get())
+                        : nullptr;
+  if ((asset.format == Format::Gltf || asset.format == Format::Glb) && src == nullptr)
+    throw Error(asset.path + ": the glTF asset has lost its source model");
+  if (asset.input_positions.empty() || asset.input_triangles.empty())
+    throw InputError(asset.path + ": the mesh has no triangles");
+  const tinygltf::Model model =
+      src ? write_back_model(*src, values, options, warnings) : fresh_model(asset, values, options);
+  tinygltf::TinyGLTF writer;
+  writer.SetImageWriter(&embed_image, nullptr);
+  if (!writer.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!binary, binary))
+    throw Error(asset.path + ": tinygltf could not write the glTF output");
+}
+
+}  // namespace sdfkit::io::detail
