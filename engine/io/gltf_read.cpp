@@ -321,6 +321,10 @@ private:
                               std::to_string(prim_index);
     const std::vector<float> xyz = reader_.floats(pos_it->second, 3, "POSITION");
     const std::size_t count = xyz.size() / 3;
+    if (count == 0) {
+      ++skipped_["triangle primitives without vertices"];
+      return;
+    }
     if (out_.positions.size() + count > UINT32_MAX) fail(path_, "too many vertices");
     const auto first = static_cast<std::uint32_t>(out_.positions.size());
 

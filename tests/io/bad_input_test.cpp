@@ -3,9 +3,14 @@
 
 #include "sdfkit/io/asset.hpp"
 
+#include "gltf_builder.hpp"
 #include "io_test_util.hpp"
 
+#include "sdfkit/core/log.hpp"
+
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace sdfkit {
 namespace {
@@ -122,6 +127,130 @@ TEST(BadInput, Ply) {
              "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
              "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
              "no triangles");
+}
+
+// A valid one-triangle glTF with `mutate` applied to the builder's pieces.
+test::GltfBuilder triangle_gltf(int mode = 4) {
+  test::GltfBuilder b;
+  const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const int idx = b.indices(std::vector<std::uint16_t>{0, 1, 2});
+  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "},\"indices\":" +
+         std::to_string(idx) + ",\"mode\":" + std::to_string(mode) + "}");
+  b.node("{\"mesh\":0}");
+  return b;
+}
+
+const std::string kScene = "\"scene\":0,\"scenes\":[{\"nodes\":[0]}]";
+
+TEST(BadInput, Gltf) {
+  ScratchDir dir;
+  expect_bad(dir, "empty.gltf", "", "invalid glTF");
+  expect_bad(dir, "json.gltf", "{\"asset\":{\"version\":\"2.0\"},\"meshes\":[", "invalid glTF");
+  expect_bad(dir, "notjson.gltf", "solid cube\nfacet normal 0 0 1\n", "invalid glTF");
+  expect_bad(dir, "noversion.gltf", "{\"meshes\":[]}", "invalid glTF");
+  expect_bad(dir, "nothing.gltf", "{\"asset\":{\"version\":\"2.0\"}}", "no triangle primitives");
+  expect_bad(dir, "magic.glb", "glTX\x02\0\0\0", "invalid glTF");
+  {
+    const std::string glb = triangle_gltf().glb(kScene);
+    expect_bad(dir, "truncated.glb", glb.substr(0, glb.size() - 10), "invalid glTF");
+  }
+  expect_bad(dir, "lines.gltf", triangle_gltf(1).data_uri_gltf(kScene),
+             "no triangle primitives (skipped 1 LINES primitives)");
+  expect_bad(dir, "points.glb", triangle_gltf(0).glb(kScene), "no triangle primitives");
+  {
+    test::GltfBuilder b = triangle_gltf();
+    expect_bad(dir, "missingbin.gltf", b.json("nowhere.bin", kScene), "invalid glTF");
+  }
+  {
+    test::GltfBuilder b;
+    const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    const int idx = b.indices(std::vector<std::uint16_t>{0, 1, 3});
+    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "},\"indices\":" +
+           std::to_string(idx) + "}");
+    b.node("{\"mesh\":0}");
+    expect_bad(dir, "range.gltf", b.data_uri_gltf(kScene),
+               "mesh 0 primitive 0 uses vertex 3 but its POSITION has 3 vertices");
+  }
+  {
+    test::GltfBuilder b;
+    const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    // An accessor that claims more vertices than its bufferView holds.
+    const int big = b.accessor(0, 0, 5126, 300, "VEC3", ",\"min\":[0,0,0],\"max\":[1,1,0]");
+    (void)pos;
+    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(big) + "}}");
+    b.node("{\"mesh\":0}");
+    expect_bad(dir, "overrun.gltf", b.data_uri_gltf(kScene),
+               "POSITION accessor 1 reads past the end of bufferView 0");
+  }
+  {
+    test::GltfBuilder b;
+    const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+    const int uv = b.accessor(0, 0, 5126, 3, "VEC2");
+    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(uv) + ",\"NORMAL\":" +
+           std::to_string(pos) + "}}");
+    b.node("{\"mesh\":0}");
+    expect_bad(dir, "type.gltf", b.data_uri_gltf(kScene), "POSITION accessor 1 has the wrong type");
+  }
+  {
+    test::GltfBuilder b;
+    const float nan = std::nanf("");
+    const int pos = b.positions({0, 0, 0, 1, nan, 0, 0, 1, 0});
+    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "}}");
+    b.node("{\"mesh\":0}");
+    expect_bad(dir, "nan.glb", b.glb(kScene), "non-finite");
+  }
+  {
+    test::GltfBuilder b = triangle_gltf();
+    b.node("{\"children\":[2]}");
+    b.node("{\"children\":[1]}");
+    expect_bad(dir, "cycle.gltf", b.data_uri_gltf("\"scene\":0,\"scenes\":[{\"nodes\":[1]}]"),
+               "cycle");
+  }
+  {
+    test::GltfBuilder b = triangle_gltf();
+    b.extra("\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],"
+            "\"extensionsRequired\":[\"KHR_draco_mesh_compression\"]");
+    expect_bad(dir, "draco.gltf", b.data_uri_gltf(kScene),
+               "requires the glTF extension KHR_draco_mesh_compression");
+  }
+}
+
+// Every prefix of a valid file loads or fails with an InputError: no crash, no hang, no other
+// exception (bad_alloc, out_of_range...).
+void truncation_sweep(const ScratchDir& dir, const std::string& name, const std::string& bytes) {
+  std::size_t loaded = 0;
+  for (std::size_t n = 0; n <= bytes.size(); ++n) {
+    // A new file per prefix: rewriting one file over and over is slow on some file systems.
+    const std::string p = dir.write(std::to_string(n) + "_" + name, bytes.substr(0, n));
+    try {
+      io::load_asset(p);
+      ++loaded;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(p + ": ", 0), 0u) << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << name << " cut at " << n << ": " << e.what();
+    }
+  }
+  EXPECT_GE(loaded, 1u) << name;  // at least the whole file
+}
+
+TEST(BadInput, EveryTruncationIsAnInputError) {
+  ScratchDir dir;
+  set_log_level(LogLevel::Error);  // tinygltf warnings about cut files are expected
+  const std::string off = "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 2 1 3\n";
+  truncation_sweep(dir, "cut.off", off);
+  truncation_sweep(dir, "cut.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::string ply =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) test::put(ply, f, true);
+  test::put<std::uint8_t>(ply, 3);
+  for (std::int32_t i : {0, 1, 2}) test::put(ply, i, true);
+  truncation_sweep(dir, "cut.ply", ply);
+  truncation_sweep(dir, "cut.glb", triangle_gltf().glb(kScene));
+  truncation_sweep(dir, "cut.gltf", triangle_gltf().data_uri_gltf(kScene));
+  set_log_level(LogLevel::Warning);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <tiny_gltf.h>
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <mutex>
 #include <sstream>
@@ -206,6 +207,26 @@ TEST_P(WriteGltfBack, KeepsTheModelAndAddsSdfAttributes) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Containers, WriteGltfBack, ::testing::Values("glb", "gltf"));
+
+TEST(WriteGltf, MissingImageFileIsAWarningAndKeepsItsUri) {
+  GltfBuilder b;
+  const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "}}");
+  b.node("{\"mesh\":0}");
+  b.extra("\"images\":[{\"uri\":\"textures/missing.png\"}],\"textures\":[{\"source\":0}]");
+  ScratchDir dir;
+  const std::string in = dir.write("tri.gltf", b.data_uri_gltf("\"scene\":0,\"scenes\":[{\"nodes\":[0]}]"));
+  WarningCapture warnings;
+  const io::Asset a = io::load_asset(in);
+  EXPECT_TRUE(std::any_of(a.warnings.begin(), a.warnings.end(), [](const std::string& w) {
+    return w.find("missing.png") != std::string::npos;
+  }));
+  const std::string out = dir.path("tri.glb");
+  io::write_field(out, a, ramp_field(a, SdfDomain::Vertex));
+  const tinygltf::Model m = load_model(out);
+  ASSERT_EQ(m.images.size(), 1u);
+  EXPECT_EQ(m.images[0].uri, "textures/missing.png");
+}
 
 TEST(WriteGltf, WithoutColorKeepsTheInputColors) {
   ScratchDir dir;

@@ -1,0 +1,87 @@
+#pragma once
+// The Shape Diameter Function by depth peeling (Shapira et al. 2008, section 3.1, Algorithms 1
+// and 2): rasterization only, no acceleration structure.
+//
+// Cameras on a sphere (spherical Fibonacci) look at the mesh with orthographic projections
+// framing its bounding sphere. Per batch of cameras, peel passes render the k-th front layer and
+// the k-th back layer of every camera at once (layered rendering: gl_Layer = 2 * camera + back)
+// into a ring of three layer images (depth and normal per pixel). After each layer a diameter
+// pass tests every query point against the previous and the current back layer; the accepted
+// ray lengths and their angles are stored per point, and a final gather pass applies the shared
+// statistics (sdfkit::gather) on the device.
+//
+// Definitions and tolerances:
+//  * A peel pass keeps a fragment only when its depth is strictly greater than the previous
+//    layer's depth at that pixel plus kPeelEpsilon (in normalised depth, where 1 = the bounding
+//    sphere's diameter): coincident duplicates collapse into one layer, and surfaces closer than
+//    ~1e-6 of the diameter count as one.
+//  * A query point (its ray origin p - offset * n) is accepted for camera c and layer k when the
+//    view direction is within half the cone angle of its inward normal, and its depth lies
+//    strictly between back layer k-1 and back layer k at its pixel, with both back depths moved
+//    to the point's exact position along the plane given by the stored normal (sub-pixel
+//    correction, limited to two pixels). The back layer is then the first exit behind the
+//    point. If front layer k lies behind the point (by more than one pixel's depth) and in front
+//    of back layer k, the closest hit is that front face (open or self-intersecting meshes).
+//  * The closest hit passes the false-intersection rule (Paper: hit normal . start normal <= 0;
+//    Cgal: view direction . hit normal > 0) or the ray is dropped.
+//  * Peeling stops when an occlusion query reports no fragment in the last layer (front and back
+//    layers are counted together), or at max_layers (a warning is logged when fragments were
+//    still coming).
+//  * Each point stores at most max_samples_per_point (length, theta) pairs. The default bound
+//    exceeds the number of cameras that can fall inside one cone, so it is never reached; with a
+//    smaller bound, samples past it are dropped (the first ones stored, in camera order, are
+//    kept) and a warning gives the number of points affected.
+
+#include "sdfkit/core/sdf.hpp"
+#include "sdfkit/vulkan/context.hpp"
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sdfkit::vk {
+
+struct DepthPeelConfig {
+  std::string device;           // see ContextConfig::device
+  int views = 256;              // cameras on the sphere
+  int resolution = 512;         // pixels per side of each camera's image
+  int max_layers = 64;          // peel iterations per camera at most
+  bool validation = false;
+  bool profile = false;         // per-pass GPU timestamps in last_timings()
+  int max_samples_per_point = 0;  // 0 = automatic bound (see above)
+  int cameras_per_batch = 0;      // 0 = automatic (layered rendering of several cameras)
+  int layers_per_submit = 0;      // 0 = automatic (peel iterations recorded per submission)
+};
+
+// Devices as `sdfkit devices` shows them, with suitability for this backend.
+std::vector<DeviceInfo> list_devices_for_depth_peel();
+
+class DepthPeelBackend final : public SdfBackend {
+public:
+  explicit DepthPeelBackend(const DepthPeelConfig& config = {});
+  ~DepthPeelBackend() override;
+
+  std::string name() const override { return "vulkan"; }
+  std::string device_name() const override;
+  void set_mesh(const Mesh& mesh) override;
+  void update_positions(std::span<const glm::vec3> positions) override;
+  RawSdf compute(const SdfQuery& query, const SdfOptions& options) override;
+  std::vector<StageTiming> last_timings() const override;
+  std::size_t device_memory_bytes() const override;
+
+  // Test entry point: runs only the device gather on given per-point samples (length in model
+  // units, theta in radians), as the diameter passes would have stored them.
+  RawSdf gather_on_device(const std::vector<std::vector<std::pair<float, float>>>& samples);
+
+  Context& context();
+  const DepthPeelConfig& config() const;
+  // Layers peeled in the last compute() (deepest batch) and whether the cap was hit.
+  int last_layer_count() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sdfkit::vk

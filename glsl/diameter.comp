@@ -1,0 +1,98 @@
+#version 450
+// Diameter pass: one invocation per query point, looping over the cameras of the batch. For
+// each camera whose view direction lies within the cone around the point's inward normal, the
+// point is accepted when its depth lies strictly between back layer k-1 and back layer k at its
+// pixel (back layer k is then the first exit behind it); see depth_peel.hpp for the rules.
+// Accepted (length, theta) pairs go to the point's slots; the count is an atomic per point.
+#extension GL_GOOGLE_include_directive : require
+#include "depth_peel_common.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(std430, set = 0, binding = 0) readonly buffer Cameras { Camera cams[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Points {
+  vec4 points[];  // per point: ray origin xyz (model units), w = 1 valid / 0 invalid; then inward normals
+};
+layout(std430, set = 0, binding = 2) buffer Counts { uint counts[]; };
+layout(std430, set = 0, binding = 3) writeonly buffer Samples { vec2 samples[]; };
+layout(set = 0, binding = 4) uniform usampler2DArray previous_layer;
+layout(set = 0, binding = 5) uniform usampler2DArray current_layer;
+
+layout(push_constant) uniform Push {
+  vec4 center_scale;    // bounding-sphere centre, 1 / framed radius R
+  uint camera_base;
+  uint camera_count;
+  uint first_layer;
+  uint point_count;
+  uint max_samples;
+  float cos_half_cone;
+  uint rule;            // 0 = Paper, 1 = Cgal
+  int resolution;
+  float front_tolerance;  // normalised depth
+} pc;
+
+// Depth of the layer texel at `px`, moved along the surface plane to the sub-pixel position
+// `pos` (pixels); kNoSurface when the texel is empty. Returns the decoded normal too.
+float layer_depth(usampler2DArray layer_image, ivec2 px, int layer, vec2 pos, Camera cam, out vec3 normal) {
+  const uvec2 t = texelFetch(layer_image, ivec3(px, layer), 0).xy;
+  const float z = uintBitsToFloat(t.x);
+  normal = vec3(0.0);
+  if (z >= 1.5) return kNoSurface;
+  normal = decode_normal(t.y);
+  // Plane through the texel centre: d(depth)/d(image x) = -n_right / n_dir (model units);
+  // one pixel is 2R/res model units, one unit of normalised depth is 2R model units.
+  const float nd = dot(normal, cam.dir.xyz);
+  const float nd_safe = nd >= 0.0 ? max(nd, 0.2) : min(nd, -0.2);
+  const vec2 delta = clamp(pos - (vec2(px) + 0.5), vec2(-0.5), vec2(0.5));
+  const float slope_r = -dot(normal, cam.right.xyz) / nd_safe;
+  const float slope_u = -dot(normal, cam.up.xyz) / nd_safe;
+  const float dz = (slope_r * delta.x + slope_u * delta.y) / float(pc.resolution);
+  return z + clamp(dz, -2.0 / float(pc.resolution), 2.0 / float(pc.resolution));
+}
+
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.point_count) return;
+  const vec4 origin = points[i];
+  if (origin.w == 0.0) return;
+  const vec3 inward = points[pc.point_count + i].xyz;
+  const vec3 q = (origin.xyz - pc.center_scale.xyz) * pc.center_scale.w;  // in units of R
+  const float res = float(pc.resolution);
+
+  for (uint c = 0u; c < pc.camera_count; ++c) {
+    const Camera cam = cams[pc.camera_base + c];
+    const float cos_theta = dot(inward, cam.dir.xyz);
+    if (cos_theta < pc.cos_half_cone) continue;
+    const vec2 ndc = vec2(dot(q, cam.right.xyz), dot(q, cam.up.xyz));
+    const vec2 pos = (ndc * 0.5 + 0.5) * res;  // framebuffer position in pixels
+    const ivec2 px = ivec2(floor(pos));
+    if (any(lessThan(px, ivec2(0))) || any(greaterThanEqual(px, ivec2(pc.resolution)))) continue;
+    const float zp = dot(q, cam.dir.xyz) * 0.5 + 0.5;
+    const int back = int(2u * c + 1u);
+
+    vec3 back_normal;
+    const float z1 = layer_depth(current_layer, px, back, pos, cam, back_normal);
+    if (z1 >= 1.5 || !(zp < z1)) continue;
+    if (pc.first_layer == 0u) {
+      vec3 n0;
+      const float z0 = layer_depth(previous_layer, px, back, pos, cam, n0);
+      if (!(z0 < zp)) continue;
+    }
+    // The closest hit: a front face of this layer between the point and the exit, if any.
+    float z_hit = z1;
+    vec3 hit_normal = back_normal;
+    vec3 front_normal;
+    const float zf = layer_depth(current_layer, px, back - 1, pos, cam, front_normal);
+    if (zf < 1.5 && zf > zp + pc.front_tolerance && zf < z1) {
+      z_hit = zf;
+      hit_normal = front_normal;
+    }
+    const bool accepted = pc.rule == 0u ? dot(hit_normal, inward) >= 0.0    // hit . outward start <= 0
+                                        : dot(cam.dir.xyz, hit_normal) > 0.0;
+    if (!accepted) continue;
+    const float length_model = (z_hit - zp) * 2.0 / pc.center_scale.w;
+    const float theta = acos(clamp(cos_theta, -1.0, 1.0));
+    const uint slot = atomicAdd(counts[i], 1u);
+    if (slot < pc.max_samples) samples[i * pc.max_samples + slot] = vec2(length_model, theta);
+  }
+}

@@ -1,0 +1,523 @@
+// The depth-peeling SDF backend: geometry upload, cameras, and per batch of cameras a render
+// graph of peel and diameter passes; a final gather pass. See depth_peel.hpp for the method.
+
+#include "sdfkit/vulkan/depth_peel.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+#include "sdfkit/vulkan/memory.hpp"
+#include "sdfkit/vulkan/pipeline.hpp"
+#include "sdfkit/vulkan/render_graph.hpp"
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+namespace sdfkit::vk {
+
+namespace {
+
+// Normalised depth (1 = bounding-sphere diameter) under which a fragment counts as the same
+// layer as the previous one.
+constexpr float kPeelEpsilon = 1e-6f;
+// The framed radius is the bounding sphere's radius times this, so nothing touches the border.
+constexpr float kFrameMargin = 1.02f;
+constexpr VkFormat kLayerFormat = VK_FORMAT_R32G32_UINT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+
+struct GpuCamera {
+  glm::vec4 right, up, dir;
+};
+struct GpuTriangle {
+  glm::vec4 p[3];
+  glm::vec4 n;
+};
+struct PeelPush {
+  glm::vec4 center_scale;
+  std::uint32_t camera_base;
+  std::uint32_t first_layer;
+  float epsilon;
+};
+struct DiameterPush {
+  glm::vec4 center_scale;
+  std::uint32_t camera_base;
+  std::uint32_t camera_count;
+  std::uint32_t first_layer;
+  std::uint32_t point_count;
+  std::uint32_t max_samples;
+  float cos_half_cone;
+  std::uint32_t rule;
+  std::int32_t resolution;
+  float front_tolerance;
+};
+struct GatherPush {
+  std::uint32_t point_count;
+  std::uint32_t max_samples;
+  float min_ray_angle;
+};
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Spherical Fibonacci directions on the whole sphere, each with an orthonormal image frame.
+std::vector<GpuCamera> make_cameras(int n) {
+  std::vector<GpuCamera> cams(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = std::fmod(i * kGoldenAngle, 2.0 * M_PI);
+    const glm::vec3 d(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                      static_cast<float>(z));
+    const Frame f = tangent_frame(glm::normalize(d));
+    cams[static_cast<std::size_t>(i)] = {glm::vec4(f.t, 0.0f), glm::vec4(f.b, 0.0f), glm::vec4(f.axis, 0.0f)};
+  }
+  return cams;
+}
+
+const VkDescriptorType kPeelBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                          VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+const VkDescriptorType kDiameterBindings[] = {
+    VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+const VkDescriptorType kGatherBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                            VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+
+}  // namespace
+
+std::vector<DeviceInfo> list_devices_for_depth_peel() {
+  DeviceRequirements req;
+  req.shader_output_layer = true;
+  return list_devices(req);
+}
+
+struct DepthPeelBackend::Impl {
+  DepthPeelConfig cfg;
+  std::unique_ptr<Context> ctx;
+  int batch = 8;            // cameras per batch
+  int layers_per_submit = 3;
+  std::vector<GpuCamera> cameras;
+
+  Pipeline peel, diameter, gather;
+  UniqueSampler sampler;
+  UniqueDescriptorPool pool;
+  VkDescriptorSet peel_sets[3]{};      // by previous ring index
+  VkDescriptorSet diameter_sets[3]{};  // by current ring index
+  VkDescriptorSet gather_set = VK_NULL_HANDLE;
+
+  Image ring[3];
+  bool ring_ready[3] = {false, false, false};
+  UniqueQueryPool occlusion;
+  TransientPool transients;
+  Buffer camera_buffer;
+
+  // Geometry.
+  std::vector<Triangle> triangles;
+  std::size_t vertex_count = 0;
+  Buffer triangle_buffer;
+  glm::vec3 center{0.0f};
+  float radius = 1.0f;
+
+  // Per-query buffers (grown as needed).
+  std::size_t point_capacity = 0, sample_capacity = 0;
+  Buffer points, counts, samples, result;
+
+  std::vector<StageTiming> timings;
+  int last_layers = 0;
+
+  explicit Impl(const DepthPeelConfig& c);
+  void upload_geometry(std::span<const glm::vec3> positions);
+  void ensure_query_buffers(std::size_t n, std::uint32_t max_samples);
+  void write_sets();
+  std::uint32_t auto_max_samples(float cone_degrees) const;
+  RawSdf run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu);
+};
+
+DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
+    : cfg(c),
+      ctx([&] {
+        ContextConfig cc;
+        cc.device = c.device;
+        cc.validation = c.validation;
+        cc.requirements.shader_output_layer = true;
+        return std::make_unique<Context>(cc);
+      }()),
+      transients(*ctx) {
+  if (cfg.views < 1 || cfg.views > 65536)
+    throw InputError("--views must be between 1 and 65536, got " + std::to_string(cfg.views));
+  if (cfg.resolution < 16 || cfg.resolution > static_cast<int>(ctx->capabilities().max_image_dimension_2d))
+    throw InputError("--resolution must be between 16 and " +
+                     std::to_string(ctx->capabilities().max_image_dimension_2d) + ", got " +
+                     std::to_string(cfg.resolution));
+  if (cfg.max_layers < 1) throw InputError("max_layers must be at least 1");
+  batch = cfg.cameras_per_batch > 0 ? cfg.cameras_per_batch : 8;
+  batch = std::min({batch, cfg.views, static_cast<int>(ctx->capabilities().max_framebuffer_layers / 2)});
+  layers_per_submit = cfg.layers_per_submit > 0 ? cfg.layers_per_submit : 3;
+  cameras = make_cameras(cfg.views);
+
+  VkDevice dev = ctx->device();
+  GraphicsPipelineDescription gd;
+  gd.vertex_shader = "depth_peel.vert";
+  gd.fragment_shader = "depth_peel.frag";
+  gd.bindings.assign(std::begin(kPeelBindings), std::end(kPeelBindings));
+  gd.push_bytes = sizeof(PeelPush);
+  gd.color_formats = {kLayerFormat};
+  gd.depth_format = kDepthFormat;
+  gd.depth_compare = VK_COMPARE_OP_LESS;
+  peel = create_graphics_pipeline(*ctx, gd);
+  diameter = create_compute_pipeline(*ctx, "diameter.comp", kDiameterBindings, sizeof(DiameterPush));
+  gather = create_compute_pipeline(*ctx, "gather.comp", kGatherBindings, sizeof(GatherPush));
+  sampler = create_nearest_sampler(dev);
+
+  std::vector<VkDescriptorType> all;
+  for (int i = 0; i < 3; ++i) all.insert(all.end(), std::begin(kPeelBindings), std::end(kPeelBindings));
+  for (int i = 0; i < 3; ++i) all.insert(all.end(), std::begin(kDiameterBindings), std::end(kDiameterBindings));
+  all.insert(all.end(), std::begin(kGatherBindings), std::end(kGatherBindings));
+  pool = create_descriptor_pool(dev, all, 7);
+  for (int i = 0; i < 3; ++i) {
+    peel_sets[i] = allocate_set(dev, pool.get(), peel.set_layout.get());
+    diameter_sets[i] = allocate_set(dev, pool.get(), diameter.set_layout.get());
+  }
+  gather_set = allocate_set(dev, pool.get(), gather.set_layout.get());
+
+  const auto res = static_cast<std::uint32_t>(cfg.resolution);
+  for (auto& r : ring)
+    r = create_image(*ctx, {kLayerFormat, res, res, static_cast<std::uint32_t>(2 * batch),
+                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
+  camera_buffer = create_buffer(*ctx, cameras.size() * sizeof(GpuCamera), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                MemoryUse::Upload);
+  std::memcpy(camera_buffer.mapped(), cameras.data(), cameras.size() * sizeof(GpuCamera));
+
+  VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, nullptr, 0, VK_QUERY_TYPE_OCCLUSION,
+                           static_cast<std::uint32_t>(layers_per_submit), 0};
+  VkQueryPool qp = VK_NULL_HANDLE;
+  check(vkCreateQueryPool(dev, &qi, nullptr, &qp), "creating the occlusion query pool");
+  occlusion = UniqueQueryPool(dev, qp);
+}
+
+void DepthPeelBackend::Impl::upload_geometry(std::span<const glm::vec3> positions) {
+  std::vector<GpuTriangle> tris(triangles.size());
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
+    const auto& t = triangles[f];
+    const glm::vec3 a = positions[t[0]], b = positions[t[1]], c = positions[t[2]];
+    GpuTriangle& g = tris[f];
+    g.p[0] = glm::vec4(a, 1.0f);
+    g.p[1] = glm::vec4(b, 1.0f);
+    g.p[2] = glm::vec4(c, 1.0f);
+    if (triangle_is_degenerate(a, b, c)) {
+      g.n = glm::vec4(0.0f);
+    } else {
+      g.n = glm::vec4(glm::normalize(glm::cross(b - a, c - a)), 1.0f);
+    }
+  }
+  const std::size_t bytes = std::max<std::size_t>(tris.size(), 1) * sizeof(GpuTriangle);
+  if (!triangle_buffer.buffer || triangle_buffer.size < bytes)
+    triangle_buffer = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
+  std::memcpy(triangle_buffer.mapped(), tris.data(), tris.size() * sizeof(GpuTriangle));
+
+  // Bounding sphere: box centre, farthest vertex (only vertices used by triangles count).
+  const Aabb box = bounding_box(positions);
+  center = box.center();
+  float r2 = 0.0f;
+  for (const auto& t : triangles)
+    for (std::uint32_t v : t) {
+      const glm::vec3 d = positions[v] - center;
+      r2 = std::max(r2, glm::dot(d, d));
+    }
+  radius = std::max(std::sqrt(r2), 1e-20f);
+}
+
+std::uint32_t DepthPeelBackend::Impl::auto_max_samples(float cone_degrees) const {
+  // Cameras inside a cone: at most views * (1 - cos(a/2)) / 2 on average; the Fibonacci set's
+  // local count deviates by a few; 25% + 8 of headroom covers every cone.
+  const double frac = (1.0 - std::cos(0.5 * cone_degrees * M_PI / 180.0)) / 2.0;
+  return static_cast<std::uint32_t>(std::ceil(cfg.views * frac * 1.25)) + 8u;
+}
+
+void DepthPeelBackend::Impl::ensure_query_buffers(std::size_t n, std::uint32_t max_samples) {
+  const std::size_t cap = std::max<std::size_t>(n, 1);
+  bool changed = false;
+  if (point_capacity < cap) {
+    points = create_buffer(*ctx, 2 * cap * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
+    counts = create_buffer(*ctx, cap * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                           MemoryUse::Upload);
+    result = create_buffer(*ctx, cap * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Readback);
+    point_capacity = cap;
+    changed = true;
+  }
+  const std::size_t sc = cap * max_samples;
+  if (sample_capacity < sc) {
+    const VkDeviceSize bytes = sc * sizeof(glm::vec2);
+    if (bytes > ctx->capabilities().max_storage_buffer_range)
+      throw DeviceError("the per-point sample storage (" + std::to_string(bytes >> 20) +
+                        " MiB) exceeds the device's storage buffer range; use fewer views or a smaller "
+                        "max_samples_per_point");
+    samples = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
+    sample_capacity = sc;
+    changed = true;
+  }
+  if (changed || !triangle_buffer.buffer) write_sets();
+}
+
+void DepthPeelBackend::Impl::write_sets() {
+  VkDevice dev = ctx->device();
+  const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  for (int i = 0; i < 3; ++i) {
+    if (triangle_buffer.buffer) {
+      const DescriptorWrite pw[] = {
+          {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, triangle_buffer.get()},
+          {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, camera_buffer.get()},
+          {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, ring[i].view.get(), ro, sampler.get()}};
+      write_set(dev, peel_sets[i], pw);
+    }
+    if (points.buffer) {
+      const int prev = (i + 2) % 3;
+      const DescriptorWrite dw[] = {
+          {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, camera_buffer.get()},
+          {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, points.get()},
+          {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, counts.get()},
+          {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, samples.get()},
+          {4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, ring[prev].view.get(), ro, sampler.get()},
+          {5, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, ring[i].view.get(), ro, sampler.get()}};
+      write_set(dev, diameter_sets[i], dw);
+    }
+  }
+  if (points.buffer) {
+    const DescriptorWrite gw[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, counts.get()},
+                                  {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, samples.get()},
+                                  {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, result.get()}};
+    write_set(dev, gather_set, gw);
+  }
+}
+
+RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu) {
+  RenderGraph g;
+  auto cnt = g.import_buffer("counts", counts.size, {counts.get()});
+  auto smp = g.import_buffer("samples", samples.size, {samples.get()});
+  auto res = g.import_buffer("result", result.size, {result.get()});
+  auto p = g.add_pass("gather", PassKind::Compute);
+  p.storage_read(cnt);
+  smp = p.storage_read_write(smp);
+  res = p.storage_write(res);
+  const GatherPush push{static_cast<std::uint32_t>(n), max_samples, kMinRayAngle};
+  p.execute([&](PassContext& pc) {
+    vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gather.get());
+    vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gather.layout.get(), 0, 1, &gather_set, 0, nullptr);
+    vkCmdPushConstants(pc.cmd, gather.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    vkCmdDispatch(pc.cmd, static_cast<std::uint32_t>((n + 63) / 64), 1, 1);
+  });
+  auto t = execute(*ctx, g.compile(), transients, {.profile = cfg.profile});
+  if (gpu) gpu->insert(gpu->end(), t.begin(), t.end());
+  RawSdf out;
+  out.values.resize(n);
+  out.kept_rays.resize(n);
+  const auto* r = static_cast<const std::uint32_t*>(result.mapped());
+  for (std::size_t i = 0; i < n; ++i) {
+    std::memcpy(&out.values[i], &r[2 * i], 4);
+    out.kept_rays[i] = r[2 * i + 1];
+  }
+  return out;
+}
+
+DepthPeelBackend::DepthPeelBackend(const DepthPeelConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+DepthPeelBackend::~DepthPeelBackend() = default;
+
+std::string DepthPeelBackend::device_name() const { return impl_->ctx->info().name; }
+Context& DepthPeelBackend::context() { return *impl_->ctx; }
+const DepthPeelConfig& DepthPeelBackend::config() const { return impl_->cfg; }
+int DepthPeelBackend::last_layer_count() const { return impl_->last_layers; }
+std::vector<StageTiming> DepthPeelBackend::last_timings() const { return impl_->timings; }
+std::size_t DepthPeelBackend::device_memory_bytes() const {
+  return static_cast<std::size_t>(impl_->ctx->allocator().peak_bytes_in_use());
+}
+
+void DepthPeelBackend::set_mesh(const Mesh& mesh) {
+  const auto t0 = Clock::now();
+  validate_mesh(mesh, "the mesh given to the Vulkan backend");
+  impl_->triangles = mesh.triangles;
+  impl_->vertex_count = mesh.positions.size();
+  impl_->upload_geometry(mesh.positions);
+  impl_->write_sets();
+  impl_->timings = {{"upload_mesh", ms_since(t0)}};
+}
+
+void DepthPeelBackend::update_positions(std::span<const glm::vec3> positions) {
+  if (impl_->triangles.empty()) throw Error("update_positions() called before set_mesh()");
+  if (positions.size() != impl_->vertex_count)
+    throw Error("update_positions() got " + std::to_string(positions.size()) + " positions for a mesh of " +
+                std::to_string(impl_->vertex_count) + " vertices");
+  const auto t0 = Clock::now();
+  impl_->upload_geometry(positions);
+  impl_->timings = {{"upload_mesh", ms_since(t0)}};
+}
+
+RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& options) {
+  Impl& m = *impl_;
+  validate_options(options);
+  if (m.triangles.empty()) throw Error("compute() called before set_mesh()");
+  m.timings.clear();
+  m.ctx->allocator().reset_peak();
+  const std::size_t n = query.size();
+  if (n == 0) return {};
+
+  auto t0 = Clock::now();
+  const std::uint32_t max_samples = m.cfg.max_samples_per_point > 0
+                                        ? static_cast<std::uint32_t>(m.cfg.max_samples_per_point)
+                                        : m.auto_max_samples(options.cone_degrees);
+  m.ensure_query_buffers(n, max_samples);
+  {
+    auto* p = static_cast<glm::vec4*>(m.points.mapped());
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::vec3 nrm = query.normals[i];
+      const bool valid = query.valid.empty() || query.valid[i];
+      p[i] = glm::vec4(query.origins[i] - query.origin_offset * nrm, valid ? 1.0f : 0.0f);
+      p[n + i] = glm::vec4(-nrm, 0.0f);
+    }
+    std::memset(m.counts.mapped(), 0, n * 4);
+  }
+  m.timings.push_back({"upload", ms_since(t0)});
+
+  t0 = Clock::now();
+  const glm::vec4 center_scale(m.center, 1.0f / (m.radius * kFrameMargin));
+  const auto res = static_cast<std::uint32_t>(m.cfg.resolution);
+  const ImageInfo ring_info{kLayerFormat, res, res, static_cast<std::uint32_t>(2 * m.batch)};
+  const ImageInfo depth_info{kDepthFormat, res, res, static_cast<std::uint32_t>(2 * m.batch)};
+  const float cos_half = std::cos(0.5f * options.cone_degrees * static_cast<float>(M_PI) / 180.0f);
+  const auto tri_vertices = static_cast<std::uint32_t>(3 * m.triangles.size());
+  const auto groups = static_cast<std::uint32_t>((n + 63) / 64);
+  std::vector<PassTiming> gpu;
+  bool cap_hit = false;
+  m.last_layers = 0;
+
+  for (int base = 0; base < m.cfg.views; base += m.batch) {
+    const auto count = static_cast<std::uint32_t>(std::min(m.batch, m.cfg.views - base));
+    int layer = 1;
+    bool more = true;
+    while (more && layer <= m.cfg.max_layers) {
+      const int steps = std::min(m.layers_per_submit, m.cfg.max_layers - layer + 1);
+      RenderGraph g;
+      ImageHandle rings[3];
+      for (int r = 0; r < 3; ++r) {
+        ExternalImage e{m.ring[r].get(), m.ring[r].view.get()};
+        e.initial = {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                     m.ring_ready[r] ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED};
+        e.final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+        rings[r] = g.import_image("layer" + std::to_string(r), ring_info, e);
+      }
+      auto depth = g.create_image("depth", depth_info);
+      auto cnt = g.import_buffer("counts", m.counts.size, {m.counts.get()});
+      auto smp = g.import_buffer("samples", m.samples.size, {m.samples.get()});
+
+      auto reset = g.add_pass("reset_queries", PassKind::Transfer);
+      reset.side_effect();
+      reset.execute([&, steps](PassContext& pc) {
+        vkCmdResetQueryPool(pc.cmd, m.occlusion.get(), 0, static_cast<std::uint32_t>(steps));
+      });
+      for (int s = 0; s < steps; ++s) {
+        const int k = layer + s;
+        const int cur = k % 3, prev = (k + 2) % 3;
+        const auto first = static_cast<std::uint32_t>(k == 1);
+        auto peel = g.add_pass("peel", PassKind::Graphics);
+        peel.sampled(rings[prev]);
+        depth = peel.depth(depth, LoadOp::Clear, 1.0f);
+        rings[cur] = peel.color(rings[cur], LoadOp::Clear, VkClearColorValue{.uint32 = {0x40000000u, 0, 0, 0}});
+        peel.side_effect();  // the occlusion query
+        const PeelPush pp{center_scale, static_cast<std::uint32_t>(base), first, kPeelEpsilon};
+        peel.execute([&, pp, prev, s, count](PassContext& pc) {
+          vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m.peel.get());
+          vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m.peel.layout.get(), 0, 1,
+                                  &m.peel_sets[prev], 0, nullptr);
+          vkCmdPushConstants(pc.cmd, m.peel.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                             0, sizeof(pp), &pp);
+          vkCmdBeginQuery(pc.cmd, m.occlusion.get(), static_cast<std::uint32_t>(s), 0);
+          vkCmdDraw(pc.cmd, tri_vertices, count, 0, 0);
+          vkCmdEndQuery(pc.cmd, m.occlusion.get(), static_cast<std::uint32_t>(s));
+        });
+        auto diam = g.add_pass("diameter", PassKind::Compute);
+        diam.sampled(rings[prev]);
+        diam.sampled(rings[cur]);
+        cnt = diam.atomic(cnt);
+        smp = diam.storage_write(smp);
+        const DiameterPush dp{center_scale, static_cast<std::uint32_t>(base), count, first,
+                              static_cast<std::uint32_t>(n), max_samples, cos_half,
+                              static_cast<std::uint32_t>(options.false_hit), m.cfg.resolution,
+                              1.0f / static_cast<float>(m.cfg.resolution)};
+        diam.execute([&, dp, cur](PassContext& pc) {
+          vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m.diameter.get());
+          vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m.diameter.layout.get(), 0, 1,
+                                  &m.diameter_sets[cur], 0, nullptr);
+          vkCmdPushConstants(pc.cmd, m.diameter.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(dp), &dp);
+          vkCmdDispatch(pc.cmd, groups, 1, 1);
+        });
+      }
+      const CompiledGraph plan = g.compile();
+      auto t = execute(*m.ctx, plan, m.transients, {.profile = m.cfg.profile});
+      gpu.insert(gpu.end(), t.begin(), t.end());
+      for (auto& r : m.ring_ready) r = true;
+
+      std::vector<std::uint64_t> frags(static_cast<std::size_t>(steps));
+      check(vkGetQueryPoolResults(m.ctx->device(), m.occlusion.get(), 0, static_cast<std::uint32_t>(steps),
+                                  frags.size() * 8, frags.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+            "reading occlusion queries");
+      for (int s = 0; s < steps; ++s)
+        if (frags[static_cast<std::size_t>(s)] == 0) {
+          more = false;
+          m.last_layers = std::max(m.last_layers, layer + s - 1);
+          break;
+        }
+      layer += steps;
+      if (more && layer > m.cfg.max_layers) {
+        cap_hit = true;
+        m.last_layers = m.cfg.max_layers;
+      }
+    }
+  }
+  if (cap_hit)
+    log_warning("depth peeling stopped at max_layers = " + std::to_string(m.cfg.max_layers) +
+                " with fragments still coming; deeper layers were ignored");
+  m.timings.push_back({"peel_and_diameter", ms_since(t0)});
+
+  t0 = Clock::now();
+  RawSdf out = m.run_gather(n, max_samples, &gpu);
+  m.timings.push_back({"gather", ms_since(t0)});
+
+  const auto* counts = static_cast<const std::uint32_t*>(m.counts.mapped());
+  std::size_t overflow = 0;
+  for (std::size_t i = 0; i < n; ++i) overflow += counts[i] > max_samples;
+  if (overflow > 0)
+    log_warning(std::to_string(overflow) + " points had more than " + std::to_string(max_samples) +
+                " accepted views; the extra samples were dropped");
+
+  if (m.cfg.profile) {
+    std::map<std::string, double> sums;
+    for (const auto& p : gpu) sums[p.pass] += p.gpu_milliseconds;
+    for (const auto& [name, msec] : sums) m.timings.push_back({"gpu_" + name, msec});
+  }
+  return out;
+}
+
+RawSdf DepthPeelBackend::gather_on_device(const std::vector<std::vector<std::pair<float, float>>>& samples) {
+  Impl& m = *impl_;
+  const std::size_t n = samples.size();
+  std::uint32_t max_samples = 1;
+  for (const auto& s : samples) max_samples = std::max<std::uint32_t>(max_samples, static_cast<std::uint32_t>(s.size()));
+  m.ensure_query_buffers(n, max_samples);
+  auto* cnt = static_cast<std::uint32_t*>(m.counts.mapped());
+  auto* smp = static_cast<glm::vec2*>(m.samples.mapped());
+  for (std::size_t i = 0; i < n; ++i) {
+    cnt[i] = static_cast<std::uint32_t>(samples[i].size());
+    for (std::size_t j = 0; j < samples[i].size(); ++j)
+      smp[i * max_samples + j] = glm::vec2(samples[i][j].first, samples[i][j].second);
+  }
+  return m.run_gather(n, max_samples, nullptr);
+}
+
+}  // namespace sdfkit::vk

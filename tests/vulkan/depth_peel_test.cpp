@@ -1,0 +1,120 @@
+// The depth-peeling backend on lavapipe with validation on: the device gather against the shared
+// definition, analytic shapes against the ideal estimator, invariances, awkward meshes.
+
+#include "vk_test_util.hpp"
+
+#include "analytic.hpp"
+#include "compare.hpp"
+
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/vulkan/depth_peel.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+namespace sdfkit::vk {
+namespace {
+
+// A backend with validation on, or nullptr when no device and SDFKIT_ALLOW_NO_DEVICE=1.
+std::unique_ptr<DepthPeelBackend> make_backend(DepthPeelConfig cfg) {
+  cfg.validation = true;
+  try {
+    return std::make_unique<DepthPeelBackend>(cfg);
+  } catch (const DeviceError&) {
+    if (test::allow_no_device()) return nullptr;
+    throw;
+  }
+}
+
+DepthPeelConfig small_config(int views = 64, int resolution = 256) {
+  DepthPeelConfig c;
+  c.views = views;
+  c.resolution = resolution;
+  return c;
+}
+
+void print_stats(const char* what, std::span<const float> a, std::span<const float> b) {
+  std::printf("[stats] %s: median rel %.4f, p90 rel %.4f, signed %.4f, pearson %.4f\n", what,
+              test::median_relative_difference(a, b), test::quantile_relative_difference(a, b, 0.9),
+              test::median_signed_relative_difference(a, b), test::pearson(a, b));
+}
+
+TEST(DepthPeel, DeviceGatherEqualsSharedGather) {
+  auto be = make_backend(small_config());
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> len(0.1f, 10.0f), th(0.0f, 1.0f);
+  std::vector<std::vector<std::pair<float, float>>> samples(500);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const std::size_t k = i % 70;  // 0 .. 69 samples, including empty points
+    for (std::size_t j = 0; j < k; ++j) {
+      float l = len(rng);
+      if (j % 5 == 4) l = samples[i][j - 1].first;  // ties
+      if (j == 0 && i % 3 == 0) l = 50.0f;          // outliers
+      const float t = (j == 1) ? 0.0f : th(rng);    // theta 0 hits the kMinRayAngle clamp
+      samples[i].push_back({l, t});
+    }
+  }
+  const RawSdf dev = be->gather_on_device(samples);
+  ASSERT_EQ(dev.values.size(), samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    std::vector<float> l, w;
+    for (const auto& [d, t] : samples[i]) {
+      l.push_back(d);
+      w.push_back(1.0f / std::max(t, kMinRayAngle));
+    }
+    const GatherResult ref = gather(l, w);
+    EXPECT_EQ(dev.kept_rays[i], ref.kept) << i;
+    EXPECT_NEAR(dev.values[i], ref.value, 2e-6f * std::max(1.0f, ref.value)) << i;
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+struct AnalyticCase {
+  const char* name;
+  Mesh mesh;
+  test::ImplicitFn fn;
+  float scale;
+  double max_median_rel, max_p90_rel;
+};
+
+TEST(DepthPeel, AnalyticShapesMatchTheIdealEstimator) {
+  // 64 views at 256^2 keep the test to seconds. Measured median relative differences to the
+  // ideal estimator (64 / 256 / 1024 views): capsule 1.8 / 1.0 / 0.9 %, torus 1.2 / 0.8 / 0.7 %,
+  // box 5.7 / 3.5 / 3.0 % (the sigma filter splits differently near the box's edges), with no
+  // bias (signed median within 0.6 %). The views sample the cone differently from the 30
+  // Fibonacci rays, so a residual ~1 % remains at any view count.
+  auto be = make_backend(small_config(64));
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  std::vector<AnalyticCase> cases;
+  cases.push_back({"capsule", shapes::capsule(1.0f, 4.0f, 48, 24),
+                   [](const glm::vec3& p) { return shapes::capsule_sdf(p, 1.0f, 4.0f); }, 6.0f, 0.03, 0.10});
+  cases.push_back({"torus", shapes::torus(3.0f, 1.0f, 64, 32),
+                   [](const glm::vec3& p) { return shapes::torus_sdf(p, 3.0f, 1.0f); }, 8.0f, 0.03, 0.06});
+  cases.push_back({"box", shapes::box(4.0f, 2.0f, 1.0f, 12),
+                   [](const glm::vec3& p) { return shapes::box_sdf(p, {4.0f, 2.0f, 1.0f}); }, 5.0f, 0.08, 0.30});
+  for (const auto& c : cases) {
+    SdfOptions o;
+    o.false_hit = FalseHitRule::Cgal;
+    be->set_mesh(c.mesh);
+    const SdfQuery q = make_query(c.mesh, o.domain);
+    const RawSdf got = be->compute(q, o);
+    const RawSdf want = test::analytic_sdf(q, o, c.fn, c.scale);
+    std::vector<float> a, b;
+    for (std::size_t i = 0; i < q.size(); ++i)
+      if (got.kept_rays[i] > 0 && want.kept_rays[i] > 0) {
+        a.push_back(got.values[i]);
+        b.push_back(want.values[i]);
+      }
+    EXPECT_GT(a.size(), q.size() * 95 / 100) << c.name;
+    print_stats(c.name, a, b);
+    EXPECT_LT(test::median_relative_difference(a, b), c.max_median_rel) << c.name;
+    EXPECT_LT(test::quantile_relative_difference(a, b, 0.9), c.max_p90_rel) << c.name;
+    EXPECT_LT(std::fabs(test::median_signed_relative_difference(a, b)), 0.01) << c.name;  // no bias
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+}  // namespace
+}  // namespace sdfkit::vk

@@ -1,0 +1,42 @@
+#pragma once
+// Shared by the Vulkan device tests: a context with validation on, the SDFKIT_ALLOW_NO_DEVICE
+// escape hatch (a missing device fails otherwise), and the zero-validation-message check.
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/vulkan/context.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+namespace sdfkit::test {
+
+inline bool allow_no_device() {
+  const char* v = std::getenv("SDFKIT_ALLOW_NO_DEVICE");
+  return v && std::string(v) == "1";
+}
+
+// A validated context, or nullptr when no device exists and SDFKIT_ALLOW_NO_DEVICE=1.
+inline std::unique_ptr<vk::Context> make_test_context(vk::ContextConfig config = {}) {
+  config.validation = true;
+  try {
+    return std::make_unique<vk::Context>(config);
+  } catch (const DeviceError&) {
+    if (allow_no_device()) return nullptr;
+    throw;
+  }
+}
+
+// Joins the validation messages for a failure message.
+inline std::string joined(const std::vector<std::string>& messages) {
+  std::string s;
+  for (const auto& m : messages) s += m + "\n";
+  return s;
+}
+
+#define SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(ctx) \
+  EXPECT_EQ((ctx).validation_message_count(), 0u) << ::sdfkit::test::joined((ctx).validation_messages())
+
+}  // namespace sdfkit::test
