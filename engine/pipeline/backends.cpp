@@ -6,7 +6,7 @@
 #include "sdfkit/opencl/opencl_backend.hpp"
 #endif
 #if SDFKIT_HAS_VULKAN
-#include "sdfkit/vulkan/depth_peel_backend.hpp"
+#include "sdfkit/vulkan/depth_peel.hpp"
 #endif
 
 #include <algorithm>
@@ -93,8 +93,10 @@ std::vector<DeviceListing> list_all_devices() {
   std::vector<DeviceListing> out;
 #if SDFKIT_HAS_VULKAN
   try {
-    for (const auto& d : vk::list_devices())
-      out.push_back({"vulkan", d.description(), d.suitable, d.rejection});
+    for (const auto& d : vk::list_devices_for_depth_peel())
+      out.push_back({"vulkan", "#" + std::to_string(d.index) + " " + d.name + " (" + d.type + ", Vulkan " +
+                                   d.api_version + ", " + d.driver + ")",
+                     d.suitable, d.rejection});
   } catch (const Error& e) {
     out.push_back({"vulkan", "(none)", false, e.what()});
   }
