@@ -12,6 +12,7 @@
 #include "sdfkit/core/error.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <map>
 #include <ostream>
@@ -110,7 +111,8 @@ private:
       for (int k = 0; k < comps; ++k) {
         double lo = static_cast<double>(data[k]), hi = lo;
         for (std::size_t i = 1; i < count; ++i) {
-          const double v = static_cast<double>(data[i * static_cast<std::size_t>(comps) + static_cast<std::size_t>(k)]);
+          const double v = static_cast<double>(
+              data[i * static_cast<std::size_t>(comps) + static_cast<std::size_t>(k)]);
           lo = std::min(lo, v);
           hi = std::max(hi, v);
         }
@@ -171,8 +173,8 @@ PrimitiveData slice(const OutputValues& values, std::uint32_t first, std::uint32
   return d;
 }
 
-void add_sdf_attributes(BufferAppender& appender, tinygltf::Primitive& prim,
-                        const PrimitiveData& d, std::size_t count) {
+void add_sdf_attributes(BufferAppender& appender, tinygltf::Primitive& prim, const PrimitiveData& d,
+                        std::size_t count) {
   prim.attributes["_SDF"] = appender.add_floats(d.raw.data(), count, TINYGLTF_TYPE_SCALAR,
                                                 TINYGLTF_TARGET_ARRAY_BUFFER, true);
   prim.attributes["_SDF_NORMALIZED"] = appender.add_floats(
@@ -194,7 +196,8 @@ tinygltf::Model write_back_model(const GltfSource& src, const OutputValues& valu
     tinygltf::Primitive& prim = model.meshes[static_cast<std::size_t>(inst.mesh)]
                                     .primitives[static_cast<std::size_t>(inst.primitive)];
     if (options.color && prim.attributes.count("COLOR_0")) ++replaced_colors;
-    add_sdf_attributes(appender, prim, slice(values, inst.first_vertex, inst.vertex_count, options.color),
+    add_sdf_attributes(appender, prim,
+                       slice(values, inst.first_vertex, inst.vertex_count, options.color),
                        inst.vertex_count);
   }
   if (replaced_colors > 0)
@@ -213,12 +216,12 @@ tinygltf::Model fresh_model(const Asset& asset, const OutputValues& values,
   const std::size_t nv = asset.input_positions.size();
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
-  prim.attributes["POSITION"] =
-      appender.add_floats(&asset.input_positions[0].x, nv, TINYGLTF_TYPE_VEC3,
-                          TINYGLTF_TARGET_ARRAY_BUFFER, true);
-  prim.indices = appender.add_indices(asset.input_triangles.data()->data(),
-                                      asset.input_triangles.size() * 3);
-  add_sdf_attributes(appender, prim, slice(values, 0, static_cast<std::uint32_t>(nv), options.color), nv);
+  prim.attributes["POSITION"] = appender.add_floats(
+      &asset.input_positions[0].x, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
+  prim.indices =
+      appender.add_indices(asset.input_triangles.data()->data(), asset.input_triangles.size() * 3);
+  add_sdf_attributes(appender, prim,
+                     slice(values, 0, static_cast<std::uint32_t>(nv), options.color), nv);
   tinygltf::Mesh mesh;
   mesh.primitives.push_back(std::move(prim));
   model.meshes.push_back(std::move(mesh));
