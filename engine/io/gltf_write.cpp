@@ -3,8 +3,9 @@
 //
 // Buffers: the output has a single buffer (all input buffers concatenated, 8-byte aligned, the
 // new data appended), stored as the BIN chunk of a .glb or as a base64 data URI in a .gltf, so
-// either output is one self-contained file. Images that were files or data URIs next to the
-// input are embedded as data URIs; images inside a bufferView stay there.
+// either output is one self-contained file. Images that were files or data URIs in the input
+// move into bufferViews of a .glb, or become data URIs in a .gltf; images already inside a
+// bufferView stay there; an image file that could not be read keeps its uri.
 
 #include "gltf_model.hpp"
 #include "writers.hpp"
@@ -79,6 +80,19 @@ public:
   int add_indices(const std::uint32_t* data, std::size_t count) {
     return add(data, count, 1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
+  }
+
+  // Appends raw bytes (an encoded image) as a bufferView without target; returns its index.
+  int add_view(const std::vector<unsigned char>& data) {
+    std::vector<unsigned char>& bytes = m_.buffers[0].data;
+    bytes.resize((bytes.size() + 7) / 8 * 8, 0);
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = bytes.size();
+    view.byteLength = data.size();
+    bytes.insert(bytes.end(), data.begin(), data.end());
+    m_.bufferViews.push_back(view);
+    return static_cast<int>(m_.bufferViews.size() - 1);
   }
 
 private:
@@ -184,11 +198,26 @@ void add_sdf_attributes(BufferAppender& appender, tinygltf::Primitive& prim, con
                                                      TINYGLTF_TARGET_ARRAY_BUFFER, false);
 }
 
-tinygltf::Model write_back_model(const GltfSource& src, const OutputValues& values,
+// For a .glb: images kept as encoded bytes (files or data URIs in the input) move into
+// bufferViews of the BIN chunk, where glTF wants a binary container's images.
+void move_images_into_buffer(tinygltf::Model& model, BufferAppender& appender) {
+  for (tinygltf::Image& image : model.images) {
+    if (image.bufferView >= 0 || image.image.empty()) continue;
+    const std::string mime = mime_for(image, image.uri);
+    if (mime.rfind("image/", 0) != 0) continue;  // stays a data URI
+    image.mimeType = mime;
+    image.bufferView = appender.add_view(image.image);
+    image.uri.clear();
+    image.image.clear();
+  }
+}
+
+tinygltf::Model write_back_model(const GltfSource& src, bool binary, const OutputValues& values,
                                  const WriteOptions& options, std::vector<std::string>& warnings) {
   tinygltf::Model model = src.model;
   merge_buffers(model);
   BufferAppender appender(model);
+  if (binary) move_images_into_buffer(model, appender);
   std::map<std::pair<int, int>, bool> done;  // (mesh, primitive): first instance wins
   std::size_t replaced_colors = 0;
   for (const GltfPrimitiveInstance& inst : src.instances) {
@@ -248,8 +277,8 @@ void write_gltf(std::ostream& out, bool binary, const Asset& asset, const Output
     throw Error(asset.path + ": the glTF asset has lost its source model");
   if (asset.input_positions.empty() || asset.input_triangles.empty())
     throw InputError(asset.path + ": the mesh has no triangles");
-  const tinygltf::Model model =
-      src ? write_back_model(*src, values, options, warnings) : fresh_model(asset, values, options);
+  const tinygltf::Model model = src ? write_back_model(*src, binary, values, options, warnings)
+                                    : fresh_model(asset, values, options);
   tinygltf::TinyGLTF writer;
   writer.SetImageWriter(&embed_image, nullptr);
   if (!writer.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!binary, binary))
