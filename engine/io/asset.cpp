@@ -61,9 +61,9 @@ Format format_from_path(const std::string& path) {
   if (ext == ".off") return Format::Off;
   if (ext == ".ply") return Format::Ply;
   if (ext == ".txt") return Format::Txt;
-  if (ext.empty())
-    detail::fail(path, "no file extension (expected .gltf, .glb, .obj, .off, .ply)");
-  detail::fail(path, "unknown extension '" + ext_raw + "' (expected .gltf, .glb, .obj, .off, .ply)");
+  if (ext.empty()) detail::fail(path, "no file extension (expected .gltf, .glb, .obj, .off, .ply)");
+  detail::fail(path,
+               "unknown extension '" + ext_raw + "' (expected .gltf, .glb, .obj, .off, .ply)");
 }
 
 const char* format_name(Format format) {

@@ -29,8 +29,8 @@ struct GltfSource {
 
 // Loads an image's encoded bytes as they are (no decoding): textures survive write-back
 // untouched and a missing or undecodable image never makes loading fail.
-bool keep_image_bytes(tinygltf::Image* image, int image_index, std::string* err,
-                      std::string* warn, int req_width, int req_height,
-                      const unsigned char* bytes, int size, void* user_data);
+bool keep_image_bytes(tinygltf::Image* image, int image_index, std::string* err, std::string* warn,
+                      int req_width, int req_height, const unsigned char* bytes, int size,
+                      void* user_data);
 
 }  // namespace sdfkit::io::detail

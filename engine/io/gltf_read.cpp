@@ -9,6 +9,7 @@
 #include <glm/mat4x4.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -103,24 +104,40 @@ private:
 
   static double decode(const unsigned char* p, int type, bool normalized) {
     switch (type) {
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
-      case TINYGLTF_COMPONENT_TYPE_DOUBLE: { double v; std::memcpy(&v, p, 8); return v; }
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float v;
+        std::memcpy(&v, p, 4);
+        return v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_DOUBLE: {
+        double v;
+        std::memcpy(&v, p, 8);
+        return v;
+      }
       case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        std::int8_t v; std::memcpy(&v, p, 1);
+        std::int8_t v;
+        std::memcpy(&v, p, 1);
         return normalized ? std::max(v / 127.0, -1.0) : v;
       }
       case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
       case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        std::int16_t v; std::memcpy(&v, p, 2);
+        std::int16_t v;
+        std::memcpy(&v, p, 2);
         return normalized ? std::max(v / 32767.0, -1.0) : v;
       }
       case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        std::uint16_t v; std::memcpy(&v, p, 2);
+        std::uint16_t v;
+        std::memcpy(&v, p, 2);
         return normalized ? v / 65535.0 : v;
       }
-      case TINYGLTF_COMPONENT_TYPE_INT: { std::int32_t v; std::memcpy(&v, p, 4); return v; }
+      case TINYGLTF_COMPONENT_TYPE_INT: {
+        std::int32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+      }
       case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        std::uint32_t v; std::memcpy(&v, p, 4);
+        std::uint32_t v;
+        std::memcpy(&v, p, 4);
         return normalized ? v / 4294967295.0 : v;
       }
       default: return 0.0;
@@ -169,8 +186,7 @@ private:
 
   template <typename T>
   void read_into(int view, std::size_t offset, std::size_t count, int components, int type,
-                 bool normalized, int accessor_index, const char* what,
-                 std::vector<T>& out) const {
+                 bool normalized, int accessor_index, const char* what, std::vector<T>& out) const {
     const std::size_t csize = component_size(type);
     if (csize == 0)
       fail(path_, std::string(what) + " accessor " + std::to_string(accessor_index) +
@@ -204,8 +220,8 @@ private:
                       " has an invalid sparse count");
     const auto n = static_cast<std::size_t>(a.sparse.count);
     std::vector<double> where;
-    read_into(a.sparse.indices.bufferView, static_cast<std::size_t>(a.sparse.indices.byteOffset),
-              n, 1, a.sparse.indices.componentType, false, index, what, where);
+    read_into(a.sparse.indices.bufferView, static_cast<std::size_t>(a.sparse.indices.byteOffset), n,
+              1, a.sparse.indices.componentType, false, index, what, where);
     std::vector<T> values;
     read_into(a.sparse.values.bufferView, static_cast<std::size_t>(a.sparse.values.byteOffset), n,
               components, a.componentType, a.normalized, index, what, values);
@@ -304,8 +320,8 @@ private:
   }
 
   void add_primitive(int node, int mesh_index, int prim_index, const glm::dmat4& world) {
-    const tinygltf::Primitive& prim =
-        m_.meshes[static_cast<std::size_t>(mesh_index)].primitives[static_cast<std::size_t>(prim_index)];
+    const tinygltf::Primitive& prim = m_.meshes[static_cast<std::size_t>(mesh_index)]
+                                          .primitives[static_cast<std::size_t>(prim_index)];
     const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
         mode != TINYGLTF_MODE_TRIANGLE_FAN) {
@@ -317,8 +333,8 @@ private:
       ++skipped_["triangle primitives without POSITION"];
       return;
     }
-    const std::string where = "mesh " + std::to_string(mesh_index) + " primitive " +
-                              std::to_string(prim_index);
+    const std::string where =
+        "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(prim_index);
     const std::vector<float> xyz = reader_.floats(pos_it->second, 3, "POSITION");
     const std::size_t count = xyz.size() / 3;
     if (count == 0) {
@@ -356,8 +372,10 @@ private:
       for (std::size_t t = 0; t + 2 < idx.size(); t += 3) emit(idx[t], idx[t + 1], idx[t + 2]);
     } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
       for (std::size_t t = 0; t + 2 < idx.size(); ++t) {
-        if (t % 2 == 0) emit(idx[t], idx[t + 1], idx[t + 2]);
-        else emit(idx[t + 1], idx[t], idx[t + 2]);
+        if (t % 2 == 0)
+          emit(idx[t], idx[t + 1], idx[t + 2]);
+        else
+          emit(idx[t + 1], idx[t], idx[t + 2]);
       }
     } else {
       for (std::size_t t = 1; t + 1 < idx.size(); ++t) emit(idx[t], idx[t + 1], idx[0]);
@@ -402,9 +420,9 @@ RawMesh read_gltf(const std::string& path, bool binary) {
   if (out.triangles.empty() && !source->instances.empty())
     fail(path, "the scene's triangle primitives have no triangles");
   if (source->instances.empty())
-    fail(path, out.warnings.empty() ? std::string("the scene has no triangle primitives")
-                                    : "the scene has no triangle primitives (" +
-                                          out.warnings.back() + ")");
+    fail(path, out.warnings.empty()
+                   ? std::string("the scene has no triangle primitives")
+                   : "the scene has no triangle primitives (" + out.warnings.back() + ")");
   out.source = std::move(source);
   return out;
 }

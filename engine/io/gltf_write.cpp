@@ -3,8 +3,9 @@
 //
 // Buffers: the output has a single buffer (all input buffers concatenated, 8-byte aligned, the
 // new data appended), stored as the BIN chunk of a .glb or as a base64 data URI in a .gltf, so
-// either output is one self-contained file. Images that were files or data URIs next to the
-// input are embedded as data URIs; images inside a bufferView stay there.
+// either output is one self-contained file. Images that were files or data URIs in the input
+// move into bufferViews of a .glb, or become data URIs in a .gltf; images already inside a
+// bufferView stay there; an image file that could not be read keeps its uri.
 
 #include "gltf_model.hpp"
 #include "writers.hpp"
@@ -12,6 +13,7 @@
 #include "sdfkit/core/error.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <map>
 #include <ostream>
@@ -80,6 +82,19 @@ public:
                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, false);
   }
 
+  // Appends raw bytes (an encoded image) as a bufferView without target; returns its index.
+  int add_view(const std::vector<unsigned char>& data) {
+    std::vector<unsigned char>& bytes = m_.buffers[0].data;
+    bytes.resize((bytes.size() + 7) / 8 * 8, 0);
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = bytes.size();
+    view.byteLength = data.size();
+    bytes.insert(bytes.end(), data.begin(), data.end());
+    m_.bufferViews.push_back(view);
+    return static_cast<int>(m_.bufferViews.size() - 1);
+  }
+
 private:
   template <typename T>
   int add(const T* data, std::size_t count, int comps, int component_type, int type, int target,
@@ -110,7 +125,8 @@ private:
       for (int k = 0; k < comps; ++k) {
         double lo = static_cast<double>(data[k]), hi = lo;
         for (std::size_t i = 1; i < count; ++i) {
-          const double v = static_cast<double>(data[i * static_cast<std::size_t>(comps) + static_cast<std::size_t>(k)]);
+          const double v = static_cast<double>(
+              data[i * static_cast<std::size_t>(comps) + static_cast<std::size_t>(k)]);
           lo = std::min(lo, v);
           hi = std::max(hi, v);
         }
@@ -171,8 +187,8 @@ PrimitiveData slice(const OutputValues& values, std::uint32_t first, std::uint32
   return d;
 }
 
-void add_sdf_attributes(BufferAppender& appender, tinygltf::Primitive& prim,
-                        const PrimitiveData& d, std::size_t count) {
+void add_sdf_attributes(BufferAppender& appender, tinygltf::Primitive& prim, const PrimitiveData& d,
+                        std::size_t count) {
   prim.attributes["_SDF"] = appender.add_floats(d.raw.data(), count, TINYGLTF_TYPE_SCALAR,
                                                 TINYGLTF_TARGET_ARRAY_BUFFER, true);
   prim.attributes["_SDF_NORMALIZED"] = appender.add_floats(
@@ -182,11 +198,26 @@ void add_sdf_attributes(BufferAppender& appender, tinygltf::Primitive& prim,
                                                      TINYGLTF_TARGET_ARRAY_BUFFER, false);
 }
 
-tinygltf::Model write_back_model(const GltfSource& src, const OutputValues& values,
+// For a .glb: images kept as encoded bytes (files or data URIs in the input) move into
+// bufferViews of the BIN chunk, where glTF wants a binary container's images.
+void move_images_into_buffer(tinygltf::Model& model, BufferAppender& appender) {
+  for (tinygltf::Image& image : model.images) {
+    if (image.bufferView >= 0 || image.image.empty()) continue;
+    const std::string mime = mime_for(image, image.uri);
+    if (mime.rfind("image/", 0) != 0) continue;  // stays a data URI
+    image.mimeType = mime;
+    image.bufferView = appender.add_view(image.image);
+    image.uri.clear();
+    image.image.clear();
+  }
+}
+
+tinygltf::Model write_back_model(const GltfSource& src, bool binary, const OutputValues& values,
                                  const WriteOptions& options, std::vector<std::string>& warnings) {
   tinygltf::Model model = src.model;
   merge_buffers(model);
   BufferAppender appender(model);
+  if (binary) move_images_into_buffer(model, appender);
   std::map<std::pair<int, int>, bool> done;  // (mesh, primitive): first instance wins
   std::size_t replaced_colors = 0;
   for (const GltfPrimitiveInstance& inst : src.instances) {
@@ -194,7 +225,8 @@ tinygltf::Model write_back_model(const GltfSource& src, const OutputValues& valu
     tinygltf::Primitive& prim = model.meshes[static_cast<std::size_t>(inst.mesh)]
                                     .primitives[static_cast<std::size_t>(inst.primitive)];
     if (options.color && prim.attributes.count("COLOR_0")) ++replaced_colors;
-    add_sdf_attributes(appender, prim, slice(values, inst.first_vertex, inst.vertex_count, options.color),
+    add_sdf_attributes(appender, prim,
+                       slice(values, inst.first_vertex, inst.vertex_count, options.color),
                        inst.vertex_count);
   }
   if (replaced_colors > 0)
@@ -213,12 +245,12 @@ tinygltf::Model fresh_model(const Asset& asset, const OutputValues& values,
   const std::size_t nv = asset.input_positions.size();
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
-  prim.attributes["POSITION"] =
-      appender.add_floats(&asset.input_positions[0].x, nv, TINYGLTF_TYPE_VEC3,
-                          TINYGLTF_TARGET_ARRAY_BUFFER, true);
-  prim.indices = appender.add_indices(asset.input_triangles.data()->data(),
-                                      asset.input_triangles.size() * 3);
-  add_sdf_attributes(appender, prim, slice(values, 0, static_cast<std::uint32_t>(nv), options.color), nv);
+  prim.attributes["POSITION"] = appender.add_floats(
+      &asset.input_positions[0].x, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
+  prim.indices =
+      appender.add_indices(asset.input_triangles.data()->data(), asset.input_triangles.size() * 3);
+  add_sdf_attributes(appender, prim,
+                     slice(values, 0, static_cast<std::uint32_t>(nv), options.color), nv);
   tinygltf::Mesh mesh;
   mesh.primitives.push_back(std::move(prim));
   model.meshes.push_back(std::move(mesh));
@@ -245,8 +277,8 @@ void write_gltf(std::ostream& out, bool binary, const Asset& asset, const Output
     throw Error(asset.path + ": the glTF asset has lost its source model");
   if (asset.input_positions.empty() || asset.input_triangles.empty())
     throw InputError(asset.path + ": the mesh has no triangles");
-  const tinygltf::Model model =
-      src ? write_back_model(*src, values, options, warnings) : fresh_model(asset, values, options);
+  const tinygltf::Model model = src ? write_back_model(*src, binary, values, options, warnings)
+                                    : fresh_model(asset, values, options);
   tinygltf::TinyGLTF writer;
   writer.SetImageWriter(&embed_image, nullptr);
   if (!writer.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!binary, binary))

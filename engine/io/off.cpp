@@ -53,9 +53,9 @@ RawMesh read_off(const std::string& path, std::string_view data) {
   // that claims more than the file can hold is an error, not an allocation.
   const auto bytes = static_cast<double>(c.remaining()) + 1.0;
   if (6.0 * static_cast<double>(nv) + 2.0 * static_cast<double>(nf) > bytes)
-    fail(path, "the header declares " + std::to_string(nv) + " vertices and " +
-                   std::to_string(nf) + " faces, more than the file's " +
-                   std::to_string(data.size()) + " bytes can hold (truncated file?)");
+    fail(path, "the header declares " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                   " faces, more than the file's " + std::to_string(data.size()) +
+                   " bytes can hold (truncated file?)");
   if (nv > static_cast<std::int64_t>(UINT32_MAX)) fail(path, "too many vertices");
 
   RawMesh out;
@@ -80,8 +80,7 @@ RawMesh read_off(const std::string& path, std::string_view data) {
     std::int64_t n = 0;
     if (!c.try_int(n)) c.expected("the corner count of face " + std::to_string(f));
     if (n < 0 || static_cast<std::size_t>(n) > c.remaining() / 2 + 1)
-      c.error("face " + std::to_string(f) + " has an impossible corner count " +
-              std::to_string(n));
+      c.error("face " + std::to_string(f) + " has an impossible corner count " + std::to_string(n));
     corners.resize(static_cast<std::size_t>(n));
     for (std::int64_t k = 0; k < n; ++k) {
       std::int64_t index = 0;

@@ -5,6 +5,7 @@
 #include "readers.hpp"
 #include "text_cursor.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <optional>
@@ -72,7 +73,8 @@ PlyType read_type(TextCursor& c) {
 
 PlyHeader parse_header(const std::string& path, std::string_view data) {
   TextCursor c(data, path);
-  if (c.word() != "ply" || !c.at_line_end()) fail(path, "not a PLY file (it does not start with 'ply')");
+  if (c.word() != "ply" || !c.at_line_end())
+    fail(path, "not a PLY file (it does not start with 'ply')");
   c.next_line();
   PlyHeader h;
   bool have_format = false;
@@ -85,10 +87,14 @@ PlyHeader parse_header(const std::string& path, std::string_view data) {
     const std::string_view key = c.word();
     if (key == "format") {
       const std::string_view enc = c.word();
-      if (enc == "ascii") h.encoding = PlyEncoding::Ascii;
-      else if (enc == "binary_little_endian") h.encoding = PlyEncoding::BinaryLittle;
-      else if (enc == "binary_big_endian") h.encoding = PlyEncoding::BinaryBig;
-      else c.error("unknown PLY format '" + TextCursor::printable(enc) + "'");
+      if (enc == "ascii")
+        h.encoding = PlyEncoding::Ascii;
+      else if (enc == "binary_little_endian")
+        h.encoding = PlyEncoding::BinaryLittle;
+      else if (enc == "binary_big_endian")
+        h.encoding = PlyEncoding::BinaryBig;
+      else
+        c.error("unknown PLY format '" + TextCursor::printable(enc) + "'");
       have_format = true;
     } else if (key == "comment" || key == "obj_info") {
       // ignored
@@ -129,8 +135,10 @@ PlyHeader parse_header(const std::string& path, std::string_view data) {
 double min_row_bytes(const PlyElement& e, PlyEncoding enc) {
   double bytes = 0.0;
   for (const PlyProperty& p : e.properties) {
-    if (enc == PlyEncoding::Ascii) bytes += 2.0;  // one digit and a separator
-    else bytes += static_cast<double>(type_size(p.is_list ? p.count_type : p.type));
+    if (enc == PlyEncoding::Ascii)
+      bytes += 2.0;  // one digit and a separator
+    else
+      bytes += static_cast<double>(type_size(p.is_list ? p.count_type : p.type));
   }
   return bytes;
 }
@@ -216,10 +224,6 @@ struct BinarySource {
   void skip_scalar(PlyType t) { b.skip(type_size(t), what); }
 };
 
-}  // namespace
-
-namespace {
-
 template <typename Source>
 void read_elements(const std::string& path, const PlyHeader& h, std::int64_t vertex_count,
                    std::size_t data_bytes, Source make_source, RawMesh& out) {
@@ -254,10 +258,15 @@ void read_elements(const std::string& path, const PlyHeader& h, std::int64_t ver
       for (std::size_t i = 0; i < e.properties.size(); ++i) {
         const PlyProperty& p = e.properties[i];
         if (!p.is_list) {
-          if (is_vertex && (static_cast<int>(i) == xyz[0] || static_cast<int>(i) == xyz[1] ||
-                            static_cast<int>(i) == xyz[2])) {
-            const int axis = static_cast<int>(i) == xyz[0] ? 0 : static_cast<int>(i) == xyz[1] ? 1 : 2;
-            out.positions[static_cast<std::size_t>(row)][axis] = static_cast<float>(src.scalar(p.type));
+          const int k = static_cast<int>(i);
+          const int axis = !is_vertex    ? -1
+                           : k == xyz[0] ? 0
+                           : k == xyz[1] ? 1
+                           : k == xyz[2] ? 2
+                                         : -1;
+          if (axis >= 0) {
+            out.positions[static_cast<std::size_t>(row)][axis] =
+                static_cast<float>(src.scalar(p.type));
           } else {
             src.skip_scalar(p.type);
           }
@@ -305,27 +314,32 @@ RawMesh read_ply(const std::string& path, std::string_view data) {
     if (e.name == "vertex") vertex_count = e.count;
   }
   if (needed > static_cast<double>(data_bytes) + 1.0)
-    fail(path, "the header declares more elements than the file's " +
-                   std::to_string(data.size()) + " bytes can hold (truncated file?)");
+    fail(path, "the header declares more elements than the file's " + std::to_string(data.size()) +
+                   " bytes can hold (truncated file?)");
   if (vertex_count > static_cast<std::int64_t>(UINT32_MAX)) fail(path, "too many vertices");
 
   RawMesh out;
   if (h.encoding == PlyEncoding::Ascii) {
     TextCursor c(data, path, h.data_start);
-    read_elements(path, h, vertex_count, data_bytes,
-                  [&](const std::string& what) { return AsciiSource{c, what}; }, out);
+    read_elements(
+        path, h, vertex_count, data_bytes,
+        [&](const std::string& what) {
+          return AsciiSource{c, what};
+        },
+        out);
   } else {
     const bool big = h.encoding == PlyEncoding::BinaryBig;
     const bool swap = big != (std::endian::native == std::endian::big);
     BinaryCursor b(path, data, h.data_start, swap);
     std::string current;
-    read_elements(path, h, vertex_count, data_bytes,
-                  [&](const std::string& what) {
-                    current = what;
-                    b.set_context(&current);
-                    return BinarySource{b, current};
-                  },
-                  out);
+    read_elements(
+        path, h, vertex_count, data_bytes,
+        [&](const std::string& what) {
+          current = what;
+          b.set_context(&current);
+          return BinarySource{b, current};
+        },
+        out);
   }
   return out;
 }

@@ -23,9 +23,9 @@ public:
 
   // Skips spaces, tabs and carriage returns, staying on the current line.
   void skip_inline_space() {
-    while (pos_ < data_.size() && (data_[pos_] == ' ' || data_[pos_] == '\t' ||
-                                   data_[pos_] == '\r' || data_[pos_] == '\f' ||
-                                   data_[pos_] == '\v'))
+    while (pos_ < data_.size() &&
+           (data_[pos_] == ' ' || data_[pos_] == '\t' || data_[pos_] == '\r' ||
+            data_[pos_] == '\f' || data_[pos_] == '\v'))
       ++pos_;
   }
 
@@ -113,8 +113,7 @@ public:
   [[noreturn]] void expected(const std::string& what) {
     skip_inline_space();
     if (at_end()) fail(path_, "unexpected end of file: expected " + what);
-    if (data_[pos_] == '\n')
-      error("expected " + what + ", found the end of the line");
+    if (data_[pos_] == '\n') error("expected " + what + ", found the end of the line");
     std::size_t end = pos_;
     while (end < data_.size() && !is_space(data_[end]) && end - pos_ < 24) ++end;
     error("expected " + what + ", found '" + printable(data_.substr(pos_, end - pos_)) + "'");

@@ -8,7 +8,6 @@
 #include "sdfkit/core/log.hpp"
 
 #include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -34,10 +33,10 @@ glm::vec3 colormap(float t) {
   const int segment = std::min(3, static_cast<int>(h));
   const float f = h - static_cast<float>(segment);
   switch (segment) {
-    case 0: return {1.0f, f, 0.0f};         // red -> yellow
-    case 1: return {1.0f - f, 1.0f, 0.0f};  // yellow -> green
-    case 2: return {0.0f, 1.0f, f};         // green -> cyan
-    default: return {0.0f, 1.0f - f, 1.0f}; // cyan -> blue
+    case 0: return {1.0f, f, 0.0f};          // red -> yellow
+    case 1: return {1.0f - f, 1.0f, 0.0f};   // yellow -> green
+    case 2: return {0.0f, 1.0f, f};          // green -> cyan
+    default: return {0.0f, 1.0f - f, 1.0f};  // cyan -> blue
   }
 }
 
@@ -80,8 +79,7 @@ void sync_file(const std::string& name, const std::string& path) {
 void write_file_atomically(const std::string& path,
                            const std::function<void(std::ostream&)>& write) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw Error(path + ": is a directory");
+  if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory");
   const std::string temp = create_temporary(path);
   try {
     {
@@ -126,8 +124,7 @@ template <typename T>
 void put_le(std::string& s, T value) {
   char bytes[sizeof(T)];
   std::memcpy(bytes, &value, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big)
-    std::reverse(bytes, bytes + sizeof(T));
+  if constexpr (std::endian::native == std::endian::big) std::reverse(bytes, bytes + sizeof(T));
   s.append(bytes, sizeof(T));
 }
 
@@ -144,7 +141,8 @@ void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values
   const bool per_vertex = values.domain == SdfDomain::Vertex;
   const std::vector<float>& q = options.normalized ? values.normalized : values.raw;
   std::string color_props;
-  if (options.color) color_props = "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (options.color)
+    color_props = "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   std::string header = "ply\nformat binary_little_endian 1.0\n";
   header += std::string("comment sdfkit shape diameter function, per ") +
             (per_vertex ? "vertex" : "face") +
@@ -175,7 +173,8 @@ void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values
   }
   for (std::size_t f = 0; f < asset.input_triangles.size(); ++f) {
     body += static_cast<char>(3);
-    for (const std::uint32_t i : asset.input_triangles[f]) put_le(body, static_cast<std::int32_t>(i));
+    for (const std::uint32_t i : asset.input_triangles[f])
+      put_le(body, static_cast<std::int32_t>(i));
     if (!per_vertex) {
       put_le(body, q[f]);
       if (options.color) put_color(body, values.normalized[f]);

@@ -40,7 +40,8 @@ TEST(BadInput, Off) {
   expect_bad(dir, "keyword.off", "PFF\n3 1 0\n", "not an OFF file");
   expect_bad(dir, "fourd.off", "4OFF\n1 0 0\n0 0 0 0\n", "unsupported OFF variant");
   expect_bad(dir, "huge.off", "OFF\n1000000000000 1 0\n0 0 0\n", "truncated file");
-  expect_bad(dir, "truncated.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1", "unexpected end of file");
+  expect_bad(dir, "truncated.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1",
+             "unexpected end of file");
   expect_bad(dir, "shortvertex.off", "OFF\n3 1 0\n0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
              "line 3: expected coordinate 3 of vertex 0, found the end of the line");
   expect_bad(dir, "number.off", "OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n",
@@ -55,7 +56,8 @@ TEST(BadInput, Off) {
   expect_bad(dir, "edgesonly.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", "no triangles");
   expect_bad(dir, "hugeface.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n",
              "impossible corner count");
-  expect_bad(dir, "binary.off", std::string("OFF\n3 1 0\n\x01\x02\xff\x00", 14) + std::string(40, '\x01'),
+  expect_bad(dir, "binary.off",
+             std::string("OFF\n3 1 0\n\x01\x02\xff\x00", 14) + std::string(40, '\x01'),
              "expected coordinate 1 of vertex 0, found '????");
 }
 
@@ -66,12 +68,16 @@ TEST(BadInput, Obj) {
   expect_bad(dir, "range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
              "triangle 0 uses vertex 4 but the file has 3 vertices");
   expect_bad(dir, "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "line 4: vertex index 0");
-  expect_bad(dir, "negative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "before the first vertex");
-  expect_bad(dir, "number.obj", "v 0 0 0\nv 1 zero 0\n", "line 2: expected coordinate 2 of vertex 2, found 'zero'");
-  expect_bad(dir, "short.obj", "v 0 0", "unexpected end of file: expected coordinate 3 of vertex 1");
+  expect_bad(dir, "negative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n",
+             "before the first vertex");
+  expect_bad(dir, "number.obj", "v 0 0 0\nv 1 zero 0\n",
+             "line 2: expected coordinate 2 of vertex 2, found 'zero'");
+  expect_bad(dir, "short.obj", "v 0 0",
+             "unexpected end of file: expected coordinate 3 of vertex 1");
   expect_bad(dir, "corner.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "expected a face corner");
   expect_bad(dir, "nan.obj", "v 0 0 0\nv 1 0 NaN\nv 0 1 0\nf 1 2 3\n", "non-finite");
-  expect_bad(dir, "overflow.obj", "v 0 0 0\nv 1 0 1e999\nv 0 1 0\nf 1 2 3\n", "expected coordinate 3");
+  expect_bad(dir, "overflow.obj", "v 0 0 0\nv 1 0 1e999\nv 0 1 0\nf 1 2 3\n",
+             "expected coordinate 3");
   expect_bad(dir, "lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", "no triangles");
 }
 
@@ -88,10 +94,13 @@ TEST(BadInput, Ply) {
   expect_bad(dir, "magic.ply", "plx\n", "not a PLY file");
   expect_bad(dir, "noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", "no 'end_header'");
   expect_bad(dir, "noformat.ply", "ply\nelement vertex 0\nend_header\n", "no 'format'");
-  expect_bad(dir, "format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n", "unknown PLY format");
-  expect_bad(dir, "type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n",
+  expect_bad(dir, "format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n",
+             "unknown PLY format");
+  expect_bad(dir, "type.ply",
+             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n",
              "line 4: unknown property type 'float128'");
-  expect_bad(dir, "keyword.ply", "ply\nformat ascii 1.0\nelemnt vertex 1\nend_header\n", "unknown PLY header line");
+  expect_bad(dir, "keyword.ply", "ply\nformat ascii 1.0\nelemnt vertex 1\nend_header\n",
+             "unknown PLY header line");
   expect_bad(dir, "noxyz.ply",
              "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n",
              "no x, y and z");
@@ -134,8 +143,8 @@ test::GltfBuilder triangle_gltf(int mode = 4) {
   test::GltfBuilder b;
   const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   const int idx = b.indices(std::vector<std::uint16_t>{0, 1, 2});
-  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "},\"indices\":" +
-         std::to_string(idx) + ",\"mode\":" + std::to_string(mode) + "}");
+  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) +
+         "},\"indices\":" + std::to_string(idx) + ",\"mode\":" + std::to_string(mode) + "}");
   b.node("{\"mesh\":0}");
   return b;
 }
@@ -165,8 +174,8 @@ TEST(BadInput, Gltf) {
     test::GltfBuilder b;
     const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
     const int idx = b.indices(std::vector<std::uint16_t>{0, 1, 3});
-    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "},\"indices\":" +
-           std::to_string(idx) + "}");
+    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) +
+           "},\"indices\":" + std::to_string(idx) + "}");
     b.node("{\"mesh\":0}");
     expect_bad(dir, "range.gltf", b.data_uri_gltf(kScene),
                "mesh 0 primitive 0 uses vertex 3 but its POSITION has 3 vertices");
@@ -186,8 +195,8 @@ TEST(BadInput, Gltf) {
     test::GltfBuilder b;
     const int pos = b.positions({0, 0, 0, 1, 0, 0, 0, 1, 0});
     const int uv = b.accessor(0, 0, 5126, 3, "VEC2");
-    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(uv) + ",\"NORMAL\":" +
-           std::to_string(pos) + "}}");
+    b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(uv) +
+           ",\"NORMAL\":" + std::to_string(pos) + "}}");
     b.node("{\"mesh\":0}");
     expect_bad(dir, "type.gltf", b.data_uri_gltf(kScene), "POSITION accessor 1 has the wrong type");
   }
@@ -208,8 +217,9 @@ TEST(BadInput, Gltf) {
   }
   {
     test::GltfBuilder b = triangle_gltf();
-    b.extra("\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],"
-            "\"extensionsRequired\":[\"KHR_draco_mesh_compression\"]");
+    b.extra(
+        "\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],"
+        "\"extensionsRequired\":[\"KHR_draco_mesh_compression\"]");
     expect_bad(dir, "draco.gltf", b.data_uri_gltf(kScene),
                "requires the glTF extension KHR_draco_mesh_compression");
   }

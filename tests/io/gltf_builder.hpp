@@ -16,7 +16,9 @@ inline std::string base64_encode(const std::string& bytes) {
       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   std::size_t i = 0;
-  auto byte = [&](std::size_t k) { return static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[k])); };
+  auto byte = [&](std::size_t k) {
+    return static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[k]));
+  };
   for (; i + 2 < bytes.size(); i += 3) {
     const std::uint32_t v = (byte(i) << 16) | (byte(i + 1) << 8) | byte(i + 2);
     for (int s = 18; s >= 0; s -= 6) out += kTable[(v >> s) & 63];
@@ -50,9 +52,9 @@ public:
                const std::string& type, const std::string& extra = "") {
     std::string a = "{";
     if (view_index >= 0) a += "\"bufferView\":" + std::to_string(view_index) + ",";
-    a += "\"byteOffset\":" + std::to_string(offset) + ",\"componentType\":" +
-         std::to_string(component_type) + ",\"count\":" + std::to_string(count) +
-         ",\"type\":\"" + type + "\"" + extra + "}";
+    a += "\"byteOffset\":" + std::to_string(offset) +
+         ",\"componentType\":" + std::to_string(component_type) +
+         ",\"count\":" + std::to_string(count) + ",\"type\":\"" + type + "\"" + extra + "}";
     accessors_.push_back(a);
     return static_cast<int>(accessors_.size() - 1);
   }
@@ -67,7 +69,8 @@ public:
       hi[i % 3] = std::max(hi[i % 3], xyz[i]);
     }
     auto arr = [](const float* v) {
-      return "[" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) + "]";
+      return "[" + std::to_string(v[0]) + "," + std::to_string(v[1]) + "," + std::to_string(v[2]) +
+             "]";
     };
     return accessor(view(bytes, 0, 34962), 0, 5126, xyz.size() / 3, "VEC3",
                     ",\"min\":" + arr(lo) + ",\"max\":" + arr(hi));

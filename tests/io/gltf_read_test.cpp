@@ -60,14 +60,14 @@ TEST(ReadGltf, NodeTransformsHierarchyInstancesAndSeams) {
   GltfBuilder b;
   const int pos = b.positions(cube.xyz);
   const int idx = b.indices(cube.idx);
-  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "},\"indices\":" +
-         std::to_string(idx) + "}");
+  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) +
+         "},\"indices\":" + std::to_string(idx) + "}");
   b.node("{\"mesh\":0,\"translation\":[10,0,0]}");
-  b.node("{\"children\":[2],\"rotation\":[0,0,0.70710678,0.70710678]}");  // 90 deg about z
+  b.node("{\"children\":[2],\"rotation\":[0,0,0.70710678,0.70710678]}");   // 90 deg about z
   b.node("{\"mesh\":0,\"matrix\":[2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,5,1]}");  // scale 2, z += 5
   ScratchDir dir;
-  const io::Asset a =
-      io::load_asset(dir.write("cubes.gltf", b.data_uri_gltf("\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}]")));
+  const io::Asset a = io::load_asset(
+      dir.write("cubes.gltf", b.data_uri_gltf("\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}]")));
   EXPECT_EQ(a.format, io::Format::Gltf);
   ASSERT_EQ(a.input_positions.size(), 48u);
   ASSERT_EQ(a.input_triangles.size(), 24u);
@@ -108,17 +108,17 @@ TEST(ReadGltf, StripsFansNonIndexedAndSkippedPrimitives) {
   const int line = b.positions({0, 0, 0, 1, 1, 1});
   b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(strip) + "},\"mode\":5}," +
          "{\"attributes\":{\"POSITION\":" + std::to_string(line) + "},\"mode\":1}," +
-         "{\"attributes\":{\"POSITION\":" + std::to_string(fan) + "},\"indices\":" +
-         std::to_string(fan_idx) + ",\"mode\":6}," +
+         "{\"attributes\":{\"POSITION\":" + std::to_string(fan) +
+         "},\"indices\":" + std::to_string(fan_idx) + ",\"mode\":6}," +
          "{\"attributes\":{\"POSITION\":" + std::to_string(line) + "},\"mode\":0}," +
          "{\"attributes\":{\"POSITION\":" + std::to_string(tris) + "}}");
   b.node("{\"mesh\":0}");
   ScratchDir dir;
   const io::Asset a = io::load_asset(dir.write("modes.gltf", b.data_uri_gltf(kScene0)));
   const std::vector<Triangle> expected = {
-      {0, 1, 2}, {2, 1, 3},                   // strip: p1 = {v1, v3, v2}, same winding
-      {5, 6, 4}, {6, 7, 4}, {7, 8, 4}, {8, 5, 4},  // fan: {v(i+1), v(i+2), v0}, first vertex 4
-      {9, 10, 11}, {12, 13, 14}};             // plain triangles
+      {0, 1, 2},   {2, 1, 3},                          // strip: p1 = {v1, v3, v2}, same winding
+      {5, 6, 4},   {6, 7, 4},   {7, 8, 4}, {8, 5, 4},  // fan: {v(i+1), v(i+2), v0}, first vertex 4
+      {9, 10, 11}, {12, 13, 14}};                      // plain triangles
   EXPECT_EQ(a.input_triangles, expected);
   EXPECT_EQ(a.input_positions.size(), 4u + 5u + 6u);
   for (const Triangle& t : a.input_triangles) {
@@ -152,22 +152,23 @@ TEST(ReadGltf, InterleavedStrideSparseAndQuantizedPositions) {
   while (sidx.size() % 4) sidx += '\0';
   for (float f : {0.f, 3.f, 0.f}) test::put(sval, f);
   const int siv = b.view(sidx), svv = b.view(sval);
-  const int spos = b.accessor(sbase_view, 0, 5126, 3, "VEC3",
-                              ",\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":" +
-                                  std::to_string(siv) +
-                                  ",\"componentType\":5123},\"values\":{\"bufferView\":" +
-                                  std::to_string(svv) + "}}");
+  const int spos = b.accessor(
+      sbase_view, 0, 5126, 3, "VEC3",
+      ",\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":" + std::to_string(siv) +
+          ",\"componentType\":5123},\"values\":{\"bufferView\":" + std::to_string(svv) + "}}");
   // KHR_mesh_quantization: normalized SHORT positions.
   std::string qbytes;
   for (std::int16_t s : {0, 0, 0, 0, 32767, 0, 0, 0, 0, 0, -32767, 0}) test::put(qbytes, s);
   const int qpos = b.accessor(b.view(qbytes, 8, 34962), 0, 5122, 3, "VEC3",
                               ",\"normalized\":true,\"min\":[0,0,-1],\"max\":[1,0,0]");
-  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(ipos) + ",\"NORMAL\":" +
-         std::to_string(inrm) + "},\"indices\":" + std::to_string(iidx) + "}," +
+  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(ipos) +
+         ",\"NORMAL\":" + std::to_string(inrm) + "},\"indices\":" + std::to_string(iidx) + "}," +
          "{\"attributes\":{\"POSITION\":" + std::to_string(spos) + "}}," +
          "{\"attributes\":{\"POSITION\":" + std::to_string(qpos) + "}}");
   b.node("{\"mesh\":0}");
-  b.extra("\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"]");
+  b.extra(
+      "\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_"
+      "quantization\"]");
   ScratchDir dir;
   const io::Asset a = io::load_asset(dir.write("layouts.gltf", b.data_uri_gltf(kScene0)));
   ASSERT_EQ(a.input_positions.size(), 9u);
@@ -199,12 +200,13 @@ TEST(ReadGltf, DataUriExternalBufferAndGlbLoadTheSame) {
   GltfBuilder b;
   const int pos = b.positions(cube.xyz);
   const int idx = b.indices(cube.idx);
-  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) + "},\"indices\":" +
-         std::to_string(idx) + "}");
+  b.mesh("{\"attributes\":{\"POSITION\":" + std::to_string(pos) +
+         "},\"indices\":" + std::to_string(idx) + "}");
   b.node("{\"mesh\":0,\"translation\":[1,2,3]}");
   ScratchDir dir;
   dir.write("cube.bin", b.bin());
-  const io::Asset external = io::load_asset(dir.write("external.gltf", b.json("cube.bin", kScene0)));
+  const io::Asset external =
+      io::load_asset(dir.write("external.gltf", b.json("cube.bin", kScene0)));
   const io::Asset data_uri = io::load_asset(dir.write("datauri.gltf", b.data_uri_gltf(kScene0)));
   const io::Asset glb = io::load_asset(dir.write("binary.GLB", b.glb(kScene0)));
   EXPECT_EQ(glb.format, io::Format::Glb);

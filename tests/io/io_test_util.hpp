@@ -86,7 +86,8 @@ void expect_input_error(F&& f, const std::string& path, const std::string& needl
   } catch (const InputError& e) {
     const std::string msg = e.what();
     EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
-    EXPECT_NE(msg.find(needle), std::string::npos) << "message: " << msg << "\nexpected: " << needle;
+    EXPECT_NE(msg.find(needle), std::string::npos)
+        << "message: " << msg << "\nexpected: " << needle;
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   } catch (const std::exception& e) {
     ADD_FAILURE() << "wrong exception type for " << path << ": " << e.what();

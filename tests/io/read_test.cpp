@@ -18,8 +18,8 @@ using test::ScratchDir;
 // A unit cube as 8 vertices and 6 quads (outward CCW), the reference for every format.
 const std::vector<glm::vec3> kCubeV = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
                                        {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-const std::vector<std::array<std::uint32_t, 4>> kCubeQ = {
-    {0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+const std::vector<std::array<std::uint32_t, 4>> kCubeQ = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                          {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
 
 // The fan triangulation every reader must produce for kCubeQ.
 std::vector<Triangle> cube_triangles() {
@@ -62,7 +62,8 @@ TEST(ReadOff, QuadsWithCommentsAndExtraColumns) {
   s << "# a comment before the keyword\nCOFF\n# counts follow\n8 6 12\n";
   for (const auto& v : kCubeV) s << v.x << ' ' << v.y << ' ' << v.z << " 255 0 0 255  # colour\n";
   s << "\n";
-  for (const auto& q : kCubeQ) s << "4  " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << " 0.5 0.5 0.5\n";
+  for (const auto& q : kCubeQ)
+    s << "4  " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << " 0.5 0.5 0.5\n";
   const io::Asset a = io::load_asset(dir.write("cube.off", s.str()));
   EXPECT_EQ(a.format, Format::Off);
   expect_cube(a);
@@ -123,13 +124,18 @@ TEST(ReadObj, AllFaceFormsAndNegativeIndices) {
   s << "vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\ng side\nusemtl red\ns off\n";
   const auto& q = kCubeQ;
   auto idx = [](std::uint32_t i) { return i + 1; };
-  s << "f " << idx(q[0][0]) << ' ' << idx(q[0][1]) << ' ' << idx(q[0][2]) << ' ' << idx(q[0][3]) << "\n";
-  s << "f " << idx(q[1][0]) << "/1 " << idx(q[1][1]) << "/2 " << idx(q[1][2]) << "/3 " << idx(q[1][3]) << "/1\n";
-  s << "f " << idx(q[2][0]) << "//1 " << idx(q[2][1]) << "//1 " << idx(q[2][2]) << "//1 " << idx(q[2][3]) << "//1\n";
-  s << "f\t" << idx(q[3][0]) << "/1/1 " << idx(q[3][1]) << "/2/1 " << idx(q[3][2]) << "/3/1 " << idx(q[3][3]) << "/1/1  # c\n";
+  s << "f " << idx(q[0][0]) << ' ' << idx(q[0][1]) << ' ' << idx(q[0][2]) << ' ' << idx(q[0][3])
+    << "\n";
+  s << "f " << idx(q[1][0]) << "/1 " << idx(q[1][1]) << "/2 " << idx(q[1][2]) << "/3 "
+    << idx(q[1][3]) << "/1\n";
+  s << "f " << idx(q[2][0]) << "//1 " << idx(q[2][1]) << "//1 " << idx(q[2][2]) << "//1 "
+    << idx(q[2][3]) << "//1\n";
+  s << "f\t" << idx(q[3][0]) << "/1/1 " << idx(q[3][1]) << "/2/1 " << idx(q[3][2]) << "/3/1 "
+    << idx(q[3][3]) << "/1/1  # c\n";
   // Negative: -1 is the last vertex read so far (index 7).
   auto neg = [](std::uint32_t i) { return static_cast<int>(i) - 8; };
-  s << "f " << neg(q[4][0]) << ' ' << neg(q[4][1]) << "/-1 " << neg(q[4][2]) << "//-1 " << neg(q[4][3]) << "/-2/-1\r\n";
+  s << "f " << neg(q[4][0]) << ' ' << neg(q[4][1]) << "/-1 " << neg(q[4][2]) << "//-1 "
+    << neg(q[4][3]) << "/-2/-1\r\n";
   s << "f " << idx(q[5][0]) << ' ' << idx(q[5][1]) << ' ' << idx(q[5][2]) << ' ' << idx(q[5][3]);
   const io::Asset a = io::load_asset(dir.write("cube.obj", s.str()));
   EXPECT_EQ(a.format, Format::Obj);
@@ -138,8 +144,8 @@ TEST(ReadObj, AllFaceFormsAndNegativeIndices) {
 
 TEST(ReadObj, LinesAndPointsAreSkippedWithAWarning) {
   ScratchDir dir;
-  const io::Asset a = io::load_asset(
-      dir.write("mixed.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\np 3\nf 1 2 3\n"));
+  const io::Asset a =
+      io::load_asset(dir.write("mixed.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\np 3\nf 1 2 3\n"));
   EXPECT_EQ(a.input_triangles.size(), 1u);
   ASSERT_EQ(a.warnings.size(), 2u);
   EXPECT_NE(a.warnings[0].find("line"), std::string::npos);
@@ -160,7 +166,8 @@ std::string cube_ply(const std::string& format) {
   if (ascii) {
     t << "7 2 0.5 1.5\n";
     for (const auto& v : kCubeV) t << v.x << " 0.25 " << v.y << " 2 -1 7 200 " << v.z << "\n";
-    for (const auto& q : kCubeQ) t << "9 4 " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << " 1 -3\n";
+    for (const auto& q : kCubeQ)
+      t << "9 4 " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << " 1 -3\n";
     t << "0 1\n";
     return s + t.str();
   }

@@ -124,8 +124,9 @@ TexturedInput write_textured_input(const ScratchDir& dir) {
          std::to_string(uva) + ",\"COLOR_0\":" + std::to_string(cola) + "},\"material\":0}");
   b.node("{\"name\":\"root\",\"mesh\":0,\"children\":[1]}");
   b.node("{\"name\":\"child\",\"mesh\":0,\"translation\":[0,0,3]}");
-  b.extra("\"materials\":[{\"name\":\"painted\",\"pbrMetallicRoughness\":{\"baseColorTexture\":"
-          "{\"index\":0}},\"emissiveTexture\":{\"index\":1}}]");
+  b.extra(
+      "\"materials\":[{\"name\":\"painted\",\"pbrMetallicRoughness\":{\"baseColorTexture\":"
+      "{\"index\":0}},\"emissiveTexture\":{\"index\":1}}]");
   b.extra("\"textures\":[{\"source\":0,\"sampler\":0},{\"source\":1}]");
   b.extra("\"samplers\":[{\"magFilter\":9728}]");
   b.extra("\"images\":[{\"uri\":\"data:image/png;base64," + test::base64_encode(in.image0_bytes) +
@@ -215,7 +216,8 @@ TEST(WriteGltf, MissingImageFileIsAWarningAndKeepsItsUri) {
   b.node("{\"mesh\":0}");
   b.extra("\"images\":[{\"uri\":\"textures/missing.png\"}],\"textures\":[{\"source\":0}]");
   ScratchDir dir;
-  const std::string in = dir.write("tri.gltf", b.data_uri_gltf("\"scene\":0,\"scenes\":[{\"nodes\":[0]}]"));
+  const std::string in =
+      dir.write("tri.gltf", b.data_uri_gltf("\"scene\":0,\"scenes\":[{\"nodes\":[0]}]"));
   WarningCapture warnings;
   const io::Asset a = io::load_asset(in);
   EXPECT_TRUE(std::any_of(a.warnings.begin(), a.warnings.end(), [](const std::string& w) {
@@ -251,7 +253,8 @@ TEST(WriteGltf, FreshModelFromOff) {
     const tinygltf::Model m = load_model(out);
     ASSERT_EQ(m.meshes.size(), 1u);
     const tinygltf::Primitive& prim = m.meshes[0].primitives.at(0);
-    const tinygltf::Accessor& pos = m.accessors[static_cast<std::size_t>(prim.attributes.at("POSITION"))];
+    const tinygltf::Accessor& pos =
+        m.accessors[static_cast<std::size_t>(prim.attributes.at("POSITION"))];
     EXPECT_EQ(pos.minValues, (std::vector<double>{0, 0, 0}));
     EXPECT_EQ(pos.maxValues, (std::vector<double>{1, 1, 1}));
     const std::vector<float> sdf = floats_of(m, prim.attributes.at("_SDF"));
@@ -279,8 +282,8 @@ TEST(WriteField, MismatchedFieldAndUnsupportedFormatsAreErrors) {
   test::expect_input_error([&] { io::write_field(out, a, f); }, out,
                            "the field has 7 values but the mesh has 8 vertices");
   const std::string off = dir.path("values.off");
-  test::expect_input_error([&] { io::write_field(off, a, ramp_field(a, SdfDomain::Vertex)); },
-                           off, "cannot store values in .off");
+  test::expect_input_error([&] { io::write_field(off, a, ramp_field(a, SdfDomain::Vertex)); }, off,
+                           "cannot store values in .off");
 }
 
 // --- PLY --------------------------------------------------------------------------------
@@ -438,13 +441,17 @@ TEST(RoundTrip, EveryInputFormatThroughEveryMeshOutput) {
   {
     const io::Asset cube = io::load_asset(inputs[0]);
     std::ostringstream obj, ply;
-    for (const auto& p : cube.input_positions) obj << "v " << p.x << ' ' << p.y << ' ' << p.z << "\n";
-    for (const auto& t : cube.input_triangles) obj << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << "\n";
+    for (const auto& p : cube.input_positions)
+      obj << "v " << p.x << ' ' << p.y << ' ' << p.z << "\n";
+    for (const auto& t : cube.input_triangles)
+      obj << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << "\n";
     inputs.push_back(dir.write("cube.obj", obj.str()));
     ply << "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
-           "property float z\nelement face 12\nproperty list uchar int vertex_indices\nend_header\n";
+           "property float z\nelement face 12\nproperty list uchar int "
+           "vertex_indices\nend_header\n";
     for (const auto& p : cube.input_positions) ply << p.x << ' ' << p.y << ' ' << p.z << "\n";
-    for (const auto& t : cube.input_triangles) ply << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << "\n";
+    for (const auto& t : cube.input_triangles)
+      ply << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << "\n";
     inputs.push_back(dir.write("cube_ascii.ply", ply.str()));
     inputs.push_back(write_textured_input(dir).path);
   }
@@ -521,8 +528,9 @@ TEST(AtomicWrite, UnwritablePlacesAreOneLineErrors) {
     EXPECT_EQ(std::string(e.what()).rfind(missing_dir + ": ", 0), 0u) << e.what();
   }
   std::filesystem::create_directory(dir.path("folder.txt"));
-  EXPECT_THROW(io::write_file_atomically(dir.path("folder.txt"), [](std::ostream& out) { out << "x"; }),
-               Error);
+  EXPECT_THROW(
+      io::write_file_atomically(dir.path("folder.txt"), [](std::ostream& out) { out << "x"; }),
+      Error);
   EXPECT_EQ(dir.files(), std::vector<std::string>{"folder.txt"});
 }
 

@@ -73,8 +73,10 @@ struct WriteOptions {
 //    the attributes _SDF (FLOAT SCALAR, model units), _SDF_NORMALIZED ([0,1]) and, with
 //    options.color, COLOR_0 (VEC3 float; an existing COLOR_0 is replaced, with a warning). A
 //    mesh instanced by several nodes stores the values of its first instance. Other inputs get
-//    a fresh minimal glTF: one mesh, one node, one buffer. A .gltf output embeds its buffers
-//    as base64 data URIs, so it is one self-contained file.
+//    a fresh minimal glTF: one mesh, one node, one buffer. Either output is one
+//    self-contained file: a single buffer (the BIN chunk of a .glb, a base64 data URI in a
+//    .gltf); images read from files or data URIs are stored in that buffer (.glb) or as data
+//    URIs (.gltf); an image file that could not be read keeps its uri.
 //  - .ply: binary little endian, the input vertices and triangles, `float quality` on vertices
 //    (per-vertex field) or faces (per-face field), with options.color uchar red/green/blue.
 //  - .txt: one value per line (%.9g), input vertex order or face order.
