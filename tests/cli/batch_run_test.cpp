@@ -31,9 +31,9 @@ protected:
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  int batch(const std::string& args) {
+  int batch(const std::string& args, int rays = 6) {
     const std::string cmd = std::string(SDFKIT_CLI) + " batch " + (dir_ / "in").string() + " --out " +
-                            (dir_ / "out").string() + " --backend opencl --rays 6 --format txt " + args +
+                            (dir_ / "out").string() + " --backend opencl --rays " + std::to_string(rays) + " --format txt " + args +
                             " >" + (dir_ / "log.txt").string() + " 2>&1";
     const int status = std::system(cmd.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -89,9 +89,9 @@ TEST_F(BatchRun, RerunSkipsCompleteResultsAndResumesTheRest) {
   EXPECT_EQ(s.at("cube-ouvert.off"), "skipped");
   EXPECT_EQ(fs::last_write_time(dir_ / "out" / "cube-ouvert.txt"), cube_time);
   // Other options are another result: recomputed, as is everything with --force.
-  batch("--rays 7");
+  batch("", 7);
   EXPECT_EQ(statuses().at("cube-ouvert.off"), "done");
-  batch("--rays 7 --force");
+  batch("--force", 7);
   EXPECT_EQ(statuses().at("cow.off"), "done");
 }
 
