@@ -13,6 +13,7 @@ void add_info_command(CLI::App& app);
 void add_compute_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
 void add_batch_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 // The options every SDF-computing command shares (compute, batch, skeleton, render).
 struct SdfCliOptions {

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   sdfkit::cli::add_compute_command(app);
   sdfkit::cli::add_devices_command(app);
   sdfkit::cli::add_batch_command(app);
+  sdfkit::cli::add_bench_command(app);
 
   try {
     app.parse(argc, argv);
