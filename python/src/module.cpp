@@ -280,7 +280,7 @@ void bind_functions(py::module_& m) {
             });
           }
         }
-        return py::module_::import("json").attr("loads")(report_to_json(report));
+        return py::dict(py::module_::import("json").attr("loads")(report_to_json(report)));
       },
       "input"_a, "output"_a = py::none(), py::kw_only(), "session"_a = nullptr, "backend"_a = "auto",
       "device"_a = "", "views"_a = 0, "resolution"_a = 0, "memory_cap"_a = 0, "per"_a = "vertex",
