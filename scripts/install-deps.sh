@@ -19,6 +19,8 @@ packages=(
   libembree-dev libtbb-dev
   # CLI, logging, tests, benchmarks
   libcli11-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev
+  # the Python module and its tests
+  pybind11-dev python3-numpy python3-dev
   # test data: CGAL's mesh data set (data.tar.gz)
   libcgal-demo
 )
