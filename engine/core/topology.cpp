@@ -57,17 +57,38 @@ struct UnionFind {
 }  // namespace
 
 Adjacency vertex_adjacency(const Mesh& mesh) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  pairs.reserve(mesh.triangles.size() * 6);
-  for (const Triangle& t : mesh.triangles) {
+  // Counting build: every corner contributes its two edge neighbours (with duplicates), then
+  // each vertex's short list is sorted and de-duplicated in place and the CSR is compacted.
+  // O(F) apart from the per-vertex sorts of about a dozen entries.
+  const std::size_t n = mesh.positions.size();
+  Adjacency adj;
+  adj.offsets.assign(n + 1, 0);
+  for (const Triangle& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      if (t[k] < n) adj.offsets[t[k] + 1] += 2;
+  std::partial_sum(adj.offsets.begin(), adj.offsets.end(), adj.offsets.begin());
+  std::vector<std::uint32_t> fill(adj.offsets.begin(), adj.offsets.end() - 1);
+  adj.indices.resize(adj.offsets[n]);
+  for (const Triangle& t : mesh.triangles)
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = t[k], b = t[(k + 1) % 3];
-      if (a == b) continue;
-      pairs.emplace_back(a, b);
-      pairs.emplace_back(b, a);
+      const std::uint32_t a = t[k];
+      if (a >= n) continue;
+      adj.indices[fill[a]++] = t[(k + 1) % 3];
+      adj.indices[fill[a]++] = t[(k + 2) % 3];
     }
+  std::uint32_t out = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto begin = adj.indices.begin() + adj.offsets[v], end = adj.indices.begin() + adj.offsets[v + 1];
+    std::sort(begin, end);
+    const std::uint32_t start = out;
+    for (auto it = begin; it != end; ++it)
+      if (*it != v && *it < n && (out == start || adj.indices[out - 1] != *it)) adj.indices[out++] = *it;
+    adj.offsets[v] = start;
   }
-  return from_pairs(mesh.positions.size(), pairs);
+  adj.offsets[n] = out;
+  adj.indices.resize(out);
+  adj.indices.shrink_to_fit();
+  return adj;
 }
 
 Adjacency face_adjacency(const Mesh& mesh) {

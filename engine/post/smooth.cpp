@@ -12,8 +12,9 @@
 
 namespace sdfkit {
 
-float mean_edge_length(const Mesh& mesh) {
-  const Adjacency adj = vertex_adjacency(mesh);
+namespace {
+// Mean length of the unique edges of a vertex adjacency.
+float mean_edge_length(const Mesh& mesh, const Adjacency& adj) {
   double sum = 0.0;
   std::size_t count = 0;
   for (std::uint32_t i = 0; i < adj.size(); ++i)
@@ -25,6 +26,9 @@ float mean_edge_length(const Mesh& mesh) {
     }
   return count ? static_cast<float>(sum / static_cast<double>(count)) : 0.0f;
 }
+}  // namespace
+
+float mean_edge_length(const Mesh& mesh) { return mean_edge_length(mesh, vertex_adjacency(mesh)); }
 
 std::vector<float> smooth_field(const Mesh& mesh, SdfDomain domain, std::span<const float> values,
                                 const SmoothOptions& options) {
@@ -35,10 +39,13 @@ std::vector<float> smooth_field(const Mesh& mesh, SdfDomain domain, std::span<co
   if (values.size() != n)
     throw Error("smoothing: " + std::to_string(values.size()) + " values for " + std::to_string(n) +
                 (per_vertex ? " vertices" : " faces"));
-  const Adjacency adj = per_vertex ? vertex_adjacency(mesh) : face_adjacency(mesh);
-  const std::vector<glm::vec3> points = per_vertex ? mesh.positions : face_centroids(mesh);
+  const Adjacency vadj = vertex_adjacency(mesh);
+  const Adjacency fadj = per_vertex ? Adjacency{} : face_adjacency(mesh);
+  const Adjacency& adj = per_vertex ? vadj : fadj;
+  const std::vector<glm::vec3> centroids = per_vertex ? std::vector<glm::vec3>{} : face_centroids(mesh);
+  const std::vector<glm::vec3>& points = per_vertex ? mesh.positions : centroids;
   float sigma = options.sigma;
-  if (!(sigma > 0.0f)) sigma = 0.5f * static_cast<float>(options.rings) * mean_edge_length(mesh);
+  if (!(sigma > 0.0f)) sigma = 0.5f * static_cast<float>(options.rings) * mean_edge_length(mesh, vadj);
   std::vector<float> out(values.begin(), values.end());
   if (!(sigma > 0.0f) || n == 0) return out;
   const float inv_two_sigma2 = 1.0f / (2.0f * sigma * sigma);
@@ -48,30 +55,40 @@ std::vector<float> smooth_field(const Mesh& mesh, SdfDomain domain, std::span<co
   threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 4096)));
 
   auto work = [&](std::size_t begin, std::size_t end) {
-    // Breadth-first rings with a visit stamp per point: no clearing between points.
+    // Breadth-first rings with a visit stamp per point (no clearing between points); the
+    // neighbourhood is collected first and weighted in a second, branch-free loop.
     std::vector<std::uint32_t> stamp(n, UINT32_MAX);
-    std::vector<std::uint32_t> ring, next;
+    std::vector<std::uint32_t> hood;
     for (std::size_t i = begin; i < end; ++i) {
       const auto self = static_cast<std::uint32_t>(i);
       stamp[i] = self;
-      ring.assign(1, self);
-      double wsum = 1.0, vsum = values[i];
-      for (int r = 0; r < options.rings && !ring.empty(); ++r) {
-        next.clear();
-        for (std::uint32_t p : ring)
+      hood.clear();
+      hood.push_back(self);
+      std::size_t ring_begin = 0;
+      for (int r = 0; r < options.rings; ++r) {
+        const std::size_t ring_end = hood.size();
+        if (ring_begin == ring_end) break;
+        for (std::size_t h = ring_begin; h < ring_end; ++h) {
+          const std::uint32_t p = hood[h];
           for (std::uint32_t k = adj.offsets[p]; k < adj.offsets[p + 1]; ++k) {
             const std::uint32_t q = adj.indices[k];
-            if (stamp[q] == self) continue;
-            stamp[q] = self;
-            next.push_back(q);
-            const glm::vec3 d = points[q] - points[i];
-            const float w = std::exp(-glm::dot(d, d) * inv_two_sigma2);
-            wsum += w;
-            vsum += static_cast<double>(w) * values[q];
+            if (stamp[q] != self) {
+              stamp[q] = self;
+              hood.push_back(q);
+            }
           }
-        ring.swap(next);
+        }
+        ring_begin = ring_end;
       }
-      out[i] = static_cast<float>(vsum / wsum);
+      const glm::vec3 c = points[i];
+      float wsum = 0.0f, vsum = 0.0f;
+      for (std::uint32_t q : hood) {
+        const glm::vec3 d = points[q] - c;
+        const float w = std::exp(-(d.x * d.x + d.y * d.y + d.z * d.z) * inv_two_sigma2);
+        wsum += w;
+        vsum += w * values[q];
+      }
+      out[i] = vsum / wsum;
     }
   };
   if (threads <= 1) {
