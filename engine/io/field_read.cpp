@@ -158,7 +158,7 @@ std::vector<float> welded_values(const Asset& asset, SdfDomain domain,
 SdfDomain domain_of_count(const Asset& asset, std::size_t count, const std::string& what) {
   if (count == asset.input_positions.size()) return SdfDomain::Vertex;
   if (count == asset.input_triangles.size()) return SdfDomain::Face;
-  fail(what, "has " + std::to_string(count) + " values but the mesh " + asset.path + " has " +
+  fail(what, "holds " + std::to_string(count) + " values but the mesh " + asset.path + " has " +
                  std::to_string(asset.input_positions.size()) + " vertices and " +
                  std::to_string(asset.input_triangles.size()) + " faces");
 }
