@@ -14,6 +14,11 @@ void add_compute_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
 void add_batch_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_smooth_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
+#ifdef SDFKIT_CLI_HAS_RENDER
+void add_render_command(CLI::App& app);
+#endif
 
 // The options every SDF-computing command shares (compute, batch, skeleton, render).
 struct SdfCliOptions {
@@ -30,5 +35,19 @@ struct SdfCliOptions {
 void add_sdf_options(CLI::App& cmd, SdfCliOptions& o);
 // Resolves the parsed strings into o.sdf / o.backend_config / o.write (throws InputError).
 void finish_sdf_options(SdfCliOptions& o);
+
+// A result's values on its welded mesh (render, compare, smooth).
+struct ResultValues {
+  io::Asset asset;
+  SdfDomain domain = SdfDomain::Vertex;
+  std::vector<float> values;  // per welded vertex or per face of asset.mesh
+  bool computed = false;      // the file held no values: computed with the SDF options
+};
+// Reads a result file (read_field); with `sdf`, a file without values (or builtin:NAME) is
+// computed instead, and o.smooth > 0 smooths the values. Without `sdf`, values are required.
+ResultValues load_or_compute(const std::string& input, const SdfCliOptions* sdf,
+                             const io::LoadOptions& load = {});
+// Throws InputError unless `path` ends in .png (any case).
+void check_png_name(const std::string& path);
 
 }  // namespace sdfkit::cli

@@ -1,6 +1,7 @@
 // PLY reader: ascii, binary_little_endian and binary_big_endian. Vertex x, y, z of any numeric
 // type; faces from the list property `vertex_indices` (or `vertex_index`) with any count and
-// index types, polygons fan-triangulated; every other element and property is read past.
+// index types, polygons fan-triangulated; a scalar `quality` of vertices or faces is kept (the
+// SDF values sdfkit writes); every other element and property is read past.
 
 #include "readers.hpp"
 #include "text_cursor.hpp"
@@ -234,8 +235,10 @@ void read_elements(const std::string& path, const PlyHeader& h, std::int64_t ver
     const bool is_face = e.name == "face";
     int xyz[3] = {-1, -1, -1};
     int face_list = -1;
+    int quality = -1;
     for (std::size_t i = 0; i < e.properties.size(); ++i) {
       const PlyProperty& p = e.properties[i];
+      if ((is_vertex || is_face) && !p.is_list && p.name == "quality") quality = static_cast<int>(i);
       if (is_vertex && !p.is_list) {
         if (p.name == "x") xyz[0] = static_cast<int>(i);
         if (p.name == "y") xyz[1] = static_cast<int>(i);
@@ -254,11 +257,18 @@ void read_elements(const std::string& path, const PlyHeader& h, std::int64_t ver
 
     const std::string what = "element '" + e.name + "'";
     auto src = make_source(what);
+    if (is_vertex && quality >= 0) out.vertex_quality.resize(out.positions.size());
     for (std::int64_t row = 0; row < e.count; ++row) {
+      float row_quality = 0.0f;
       for (std::size_t i = 0; i < e.properties.size(); ++i) {
         const PlyProperty& p = e.properties[i];
         if (!p.is_list) {
           const int k = static_cast<int>(i);
+          if (k == quality) {
+            row_quality = static_cast<float>(src.scalar(p.type));
+            if (is_vertex) out.vertex_quality[static_cast<std::size_t>(row)] = row_quality;
+            continue;
+          }
           const int axis = !is_vertex    ? -1
                            : k == xyz[0] ? 0
                            : k == xyz[1] ? 1
@@ -293,6 +303,7 @@ void read_elements(const std::string& path, const PlyHeader& h, std::int64_t ver
         if (n < 3) ++skipped_faces;
         append_fan(out.triangles, corners.data(), corners.size());
       }
+      if (is_face && quality >= 0) out.face_quality.resize(out.triangles.size(), row_quality);
     }
   }
   if (skipped_faces > 0)

@@ -18,6 +18,10 @@ struct RawMesh {
   std::vector<Triangle> triangles;
   std::vector<std::string> warnings;
   std::shared_ptr<const void> source;  // glTF: the model kept for write-back
+  // PLY only: the scalar property `quality` of the vertex element (one per vertex) and of the
+  // face element (one per triangle: a polygon's value repeats over its fan); empty when absent.
+  std::vector<float> vertex_quality;
+  std::vector<float> face_quality;
 };
 
 // Throws InputError("<path>: <problem>").

@@ -1,0 +1,94 @@
+// sdfkit smooth: k-ring Gaussian smoothing of a result file, written like compute's output.
+// Also the result loading shared by render and compare.
+#include "commands.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/io/field.hpp"
+#include "sdfkit/post/smooth.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+namespace sdfkit::cli {
+
+void check_png_name(const std::string& path) {
+  std::string lower = path;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (!lower.ends_with(".png")) throw InputError(path + ": pictures are written as PNG (use a .png name)");
+}
+
+ResultValues load_or_compute(const std::string& input, const SdfCliOptions* sdf, const io::LoadOptions& load) {
+  ResultValues r;
+  if (input.starts_with("builtin:")) {
+    if (!sdf) throw InputError(input + ": a generated shape holds no values");
+    r.asset = load_input(input, load);
+  } else {
+    io::FieldFile f = io::read_field(input, sdf ? io::ValuesRequired::No : io::ValuesRequired::Yes, load);
+    r.asset = std::move(f.asset);
+    if (!f.values.empty()) {
+      r.domain = f.domain;
+      r.values = io::welded_values(r.asset, f.domain, f.values);
+    }
+  }
+  if (r.values.empty()) {
+    std::unique_ptr<SdfBackend> backend = make_backend(sdf->backend_config);
+    backend->set_mesh(r.asset.mesh);
+    SdfField field = compute_sdf(*backend, r.asset.mesh, sdf->sdf);
+    r.domain = field.domain;
+    r.values = std::move(field.values);
+    r.computed = true;
+  }
+  if (sdf && sdf->smooth > 0) {
+    SmoothOptions so;
+    so.rings = sdf->smooth;
+    r.values = smooth_field(r.asset.mesh, r.domain, r.values, so);
+  }
+  return r;
+}
+
+void add_smooth_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("smooth", "k-ring Gaussian smoothing of a result file");
+  struct Args {
+    std::string input, output;
+    SmoothOptions smooth;
+    io::LoadOptions load;
+    io::WriteOptions write;
+    bool no_color = false, quiet = false;
+  };
+  auto a = std::make_shared<Args>();
+  cmd->add_option("RESULT", a->input, "A result: .glb/.gltf with _SDF, .ply with quality")->required();
+  cmd->add_option("-o,--output", a->output, "Output file: .glb .gltf (per vertex), .ply, .txt")->required();
+  cmd->add_option("--rings,-k", a->smooth.rings, "Rings K: each point averages its neighbours up to K edges away")
+      ->check(CLI::Range(1, 64));
+  cmd->add_option("--sigma", a->smooth.sigma,
+                  "Gaussian sigma in model units (default: K * mean edge length / 2)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", a->smooth.threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--normalize", a->write.normalized, "Write values normalised to [0, 1]");
+  cmd->add_flag("--no-color", a->no_color, "Do not write COLOR_0 / PLY colours");
+  cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
+  cmd->callback([a] {
+    a->write.color = !a->no_color;
+    const ResultValues r = load_or_compute(a->input, nullptr, a->load);
+    const auto start = std::chrono::steady_clock::now();
+    SdfField field;
+    field.domain = r.domain;
+    field.values = smooth_field(r.asset.mesh, r.domain, r.values, a->smooth);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    field.kept_rays.assign(field.values.size(), 0);
+    field.filled.assign(field.values.size(), 0);
+    io::write_field(a->output, r.asset, field, a->write);
+    if (!a->quiet)
+      std::printf("%s: %zu %s values smoothed over %d rings in %.1f ms -> %s\n", a->input.c_str(),
+                  field.values.size(), r.domain == SdfDomain::Vertex ? "vertex" : "face", a->smooth.rings, ms,
+                  a->output.c_str());
+  });
+}
+
+}  // namespace sdfkit::cli

@@ -1,0 +1,322 @@
+// MeshRenderer: the mesh views of a figure drawn by Vulkan through the render graph. The mesh
+// is uploaded as a triangle soup (position, normal, value per corner) so per-vertex fields
+// shade smoothly and per-face fields get one flat colour; the palette lives in a storage
+// buffer read by the fragment stage; the skeleton overlay is a second graphics pass.
+
+#include "sdfkit/render/figure.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/io/asset.hpp"
+#include "sdfkit/vulkan/context.hpp"
+
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+namespace sdfkit::render {
+namespace {
+
+constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+
+struct SoupVertex {
+  glm::vec3 position, normal;
+  float value;
+};
+static_assert(sizeof(SoupVertex) == 28);
+
+struct MeshPush {
+  glm::mat4 view_projection;
+  glm::vec4 eye;
+  glm::vec4 scale;
+};
+struct OverlayPush {
+  glm::mat4 view_projection;
+  glm::vec4 viewport;
+};
+struct Segment {
+  glm::vec4 a, b, color;
+};
+
+constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+const VkDescriptorType kOneStorageBuffer[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+
+vk::Pipeline make_mesh_pipeline(vk::Context& ctx) {
+  vk::GraphicsPipelineDescription d;
+  d.vertex_shader = "render_mesh.vert";
+  d.fragment_shader = "render_mesh.frag";
+  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+  d.push_bytes = sizeof(MeshPush);
+  d.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SoupVertex, position)},
+                  {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SoupVertex, normal)},
+                  {2, 0, VK_FORMAT_R32_SFLOAT, offsetof(SoupVertex, value)}};
+  d.vertex_stride = sizeof(SoupVertex);
+  d.color_formats = {kColorFormat};
+  d.depth_format = kDepthFormat;
+  return vk::create_graphics_pipeline(ctx, d);
+}
+
+vk::Pipeline make_overlay_pipeline(vk::Context& ctx) {
+  vk::GraphicsPipelineDescription d;
+  d.vertex_shader = "render_overlay.vert";
+  d.fragment_shader = "render_overlay.frag";
+  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+  d.push_bytes = sizeof(OverlayPush);
+  d.color_formats = {kColorFormat};
+  d.depth_format = kDepthFormat;
+  d.depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL;  // points, drawn last, win over line ends
+  return vk::create_graphics_pipeline(ctx, d);
+}
+
+// A host-visible buffer holding `bytes`.
+vk::Buffer upload(vk::Context& ctx, const void* data, std::size_t bytes, VkBufferUsageFlags usage) {
+  vk::Buffer b = vk::create_buffer(ctx, bytes, usage, vk::MemoryUse::Upload);
+  std::memcpy(b.mapped(), data, bytes);
+  return b;
+}
+
+// Imported into a graph: written by the host before the submission.
+vk::ExternalBuffer host_written(const vk::Buffer& b) {
+  vk::ExternalBuffer e;
+  e.buffer = b.get();
+  e.initial = {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED};
+  return e;
+}
+
+void set_view(VkCommandBuffer cmd, const SceneView& v) {
+  const VkViewport vp{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.width),
+                      static_cast<float>(v.height), 0.0f, 1.0f};
+  const VkRect2D sc{{v.x, v.y}, {static_cast<std::uint32_t>(v.width), static_cast<std::uint32_t>(v.height)}};
+  vkCmdSetViewport(cmd, 0, 1, &vp);
+  vkCmdSetScissor(cmd, 0, 1, &sc);
+}
+
+}  // namespace
+
+glm::vec3 ColorScale::color(float value) const {
+  if (palette.empty()) return glm::vec3(0.5f);
+  const float range = hi - lo;
+  float t = range > 0.0f ? (value - lo) / range : 0.0f;
+  if (!(t > 0.0f)) t = 0.0f;
+  if (t > 1.0f) t = 1.0f;
+  const int last = static_cast<int>(palette.size()) - 1;
+  const float x = t * static_cast<float>(last);
+  const int i = std::min(static_cast<int>(x), std::max(last - 1, 0));
+  const float f = std::clamp(x - static_cast<float>(i), 0.0f, 1.0f);
+  return palette[static_cast<std::size_t>(i)] * (1.0f - f) +
+         palette[static_cast<std::size_t>(std::min(i + 1, last))] * f;
+}
+
+ColorScale sdf_scale(float lo, float hi) {
+  ColorScale s;
+  s.lo = lo;
+  s.hi = hi;
+  for (int i = 0; i < 256; ++i) s.palette.push_back(io::colormap(static_cast<float>(i) / 255.0f));
+  return s;
+}
+
+ColorScale difference_scale(float limit) {
+  ColorScale s;
+  s.lo = 0.0f;
+  s.hi = limit;
+  s.palette = {glm::vec3(1.0f), glm::vec3(1.0f, 0.0f, 0.0f)};
+  return s;
+}
+
+std::vector<SceneView> orbit_views(const Mesh& mesh, int count, int width, int height) {
+  if (count < 1) throw InputError("a figure needs at least one view");
+  if (width < 1 || height < 1) throw InputError("the image is empty");
+  // The grid whose cells are largest (the smaller side counts); fewer rows on ties.
+  int cols = 1, best = -1;
+  for (int c = 1; c <= count; ++c) {
+    const int rows = (count + c - 1) / c;
+    const int side = std::min(width / c, height / rows);
+    if (side > best) {
+      best = side;
+      cols = c;
+    }
+  }
+  const int rows = (count + cols - 1) / cols;
+  const int cell_w = width / cols, cell_h = height / rows;
+  if (cell_w < 1 || cell_h < 1) throw InputError("the image is too small for " + std::to_string(count) + " views");
+
+  const Aabb box = bounding_box(mesh.positions);
+  const glm::vec3 center = box.center();
+  const float radius = std::max(0.5f * box.diagonal(), 1e-6f);
+  const float margin = 1.05f;
+  // The bounding sphere (with a margin) fills the cell's smaller side.
+  const float aspect = static_cast<float>(cell_w) / static_cast<float>(cell_h);
+  const float half_h = aspect >= 1.0f ? radius * margin : radius * margin / aspect;
+  const float half_w = half_h * aspect;
+  const float elevation = 20.0f * std::numbers::pi_v<float> / 180.0f;
+
+  std::vector<SceneView> views;
+  for (int i = 0; i < count; ++i) {
+    const float azimuth = (30.0f + 360.0f * static_cast<float>(i) / static_cast<float>(count)) *
+                          std::numbers::pi_v<float> / 180.0f;
+    const glm::vec3 eye_dir(std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
+                            std::cos(elevation) * std::cos(azimuth));
+    const glm::mat4 view = glm::lookAtRH(center + eye_dir * (3.0f * radius), center, glm::vec3(0, 1, 0));
+    glm::mat4 proj = glm::orthoRH_ZO(-half_w, half_w, -half_h, half_h, radius, 5.0f * radius);
+    proj[1][1] = -proj[1][1];  // Vulkan's y points down
+    SceneView v;
+    v.view_projection = proj * view;
+    v.eye = eye_dir;
+    v.x = (i % cols) * cell_w;
+    v.y = (i / cols) * cell_h;
+    v.width = cell_w;
+    v.height = cell_h;
+    v.pixels_per_unit = static_cast<float>(cell_h) / (2.0f * half_h);
+    views.push_back(v);
+  }
+  return views;
+}
+
+MeshRenderer::MeshRenderer(vk::Context& ctx)
+    : ctx_(ctx),
+      mesh_pipeline_(make_mesh_pipeline(ctx)),
+      overlay_pipeline_(make_overlay_pipeline(ctx)),
+      descriptor_pool_(vk::create_descriptor_pool(ctx.device(), kOneStorageBuffer, 2)),
+      transients_(ctx) {
+  mesh_set_ = vk::allocate_set(ctx.device(), descriptor_pool_.get(), mesh_pipeline_.set_layout.get());
+  overlay_set_ = vk::allocate_set(ctx.device(), descriptor_pool_.get(), overlay_pipeline_.set_layout.get());
+}
+
+void MeshRenderer::set_mesh(const Mesh& mesh, std::span<const float> values, SdfDomain domain,
+                            const ColorScale& scale) {
+  const bool per_face = domain == SdfDomain::Face;
+  const std::size_t expected = per_face ? mesh.face_count() : mesh.vertex_count();
+  if (values.size() != expected)
+    throw InputError("cannot render " + std::to_string(values.size()) + " values on a mesh with " +
+                     std::to_string(expected) + (per_face ? " faces" : " vertices"));
+  if (mesh.face_count() == 0) throw InputError("cannot render a mesh without faces");
+  if (scale.palette.size() < 2) throw InputError("a colour scale needs at least two colours");
+
+  const std::vector<glm::vec3> normals = per_face ? face_normals(mesh) : vertex_normals(mesh);
+  const auto value_of = [&](std::size_t i) { return std::isfinite(values[i]) ? values[i] : scale.lo; };
+  std::vector<SoupVertex> soup;
+  soup.reserve(3 * mesh.face_count());
+  for (std::size_t f = 0; f < mesh.face_count(); ++f)
+    for (const std::uint32_t v : mesh.triangles[f]) {
+      const std::size_t k = per_face ? f : v;
+      soup.push_back({mesh.positions[v], normals[k], value_of(k)});
+    }
+  vertices_ = upload(ctx_, soup.data(), soup.size() * sizeof(SoupVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  vertex_count_ = static_cast<std::uint32_t>(soup.size());
+
+  std::vector<glm::vec4> palette;
+  for (const glm::vec3& c : scale.palette) palette.emplace_back(c, 1.0f);
+  palette_ = upload(ctx_, palette.data(), palette.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  palette_size_ = static_cast<std::uint32_t>(palette.size());
+  lo_ = scale.lo;
+  hi_ = scale.hi;
+  const vk::DescriptorWrite w[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, palette_.get()}};
+  vk::write_set(ctx_.device(), mesh_set_, w);
+}
+
+void MeshRenderer::set_overlay(std::span<const std::array<glm::vec3, 2>> lines,
+                               std::span<const glm::vec3> points) {
+  std::vector<Segment> segs;
+  const glm::vec4 line_color(0.05f, 0.05f, 0.05f, 1.0f), point_color(0.55f, 0.0f, 0.55f, 1.0f);
+  for (const auto& l : lines) segs.push_back({glm::vec4(l[0], 1.5f), glm::vec4(l[1], 0.0f), line_color});
+  for (const glm::vec3& p : points) segs.push_back({glm::vec4(p, 3.0f), glm::vec4(p, 0.0f), point_color});
+  segment_count_ = static_cast<std::uint32_t>(segs.size());
+  if (segs.empty()) {
+    segments_ = {};
+    return;
+  }
+  segments_ = upload(ctx_, segs.data(), segs.size() * sizeof(Segment), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  const vk::DescriptorWrite w[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, segments_.get()}};
+  vk::write_set(ctx_.device(), overlay_set_, w);
+}
+
+vk::ImageHandle MeshRenderer::add_passes(vk::RenderGraph& graph, std::uint32_t width, std::uint32_t height,
+                                         std::span<const SceneView> views, glm::vec3 background) {
+  if (vertex_count_ == 0) throw Error("MeshRenderer::add_passes before set_mesh");
+  const std::uint32_t max_side = ctx_.capabilities().max_image_dimension_2d;
+  if (max_side && (width > max_side || height > max_side))
+    throw InputError("a " + std::to_string(width) + " x " + std::to_string(height) +
+                     " image is larger than the device allows (" + std::to_string(max_side) + " pixels a side)");
+  const std::vector<SceneView> v(views.begin(), views.end());
+  auto color = graph.create_image("figure.color", {kColorFormat, width, height, 1});
+  auto depth = graph.create_image("figure.depth", {kDepthFormat, width, height, 1});
+  auto vbuf = graph.import_buffer("figure.vertices", vertices_.size, host_written(vertices_));
+  auto pal = graph.import_buffer("figure.palette", palette_.size, host_written(palette_));
+
+  auto mesh = graph.add_pass("figure.mesh", vk::PassKind::Graphics);
+  color = mesh.color(color, vk::LoadOp::Clear, VkClearColorValue{{background.x, background.y, background.z, 1.0f}});
+  depth = mesh.depth(depth, vk::LoadOp::Clear, 1.0f);
+  mesh.vertex(vbuf);
+  mesh.storage_read(pal);
+  mesh.execute([this, v, vbuf](vk::PassContext& pc) {
+    vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipeline_.get());
+    vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipeline_.layout.get(), 0, 1,
+                            &mesh_set_, 0, nullptr);
+    const VkBuffer b = pc.buffer(vbuf);
+    const VkDeviceSize offset = 0;
+    vkCmdBindVertexBuffers(pc.cmd, 0, 1, &b, &offset);
+    for (const SceneView& view : v) {
+      set_view(pc.cmd, view);
+      const MeshPush push{view.view_projection, glm::vec4(view.eye, 0.0f),
+                          glm::vec4(lo_, hi_, static_cast<float>(palette_size_), 0.0f)};
+      vkCmdPushConstants(pc.cmd, mesh_pipeline_.layout.get(), kStages, 0, sizeof(push), &push);
+      vkCmdDraw(pc.cmd, vertex_count_, 1, 0, 0);
+    }
+  });
+
+  if (segment_count_ > 0) {
+    auto segs = graph.import_buffer("figure.skeleton", segments_.size, host_written(segments_));
+    auto overlay = graph.add_pass("figure.skeleton", vk::PassKind::Graphics);
+    color = overlay.color(color, vk::LoadOp::Load);
+    depth = overlay.depth(depth, vk::LoadOp::Clear, 1.0f);  // on top of the mesh
+    overlay.storage_read(segs);
+    overlay.execute([this, v](vk::PassContext& pc) {
+      vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, overlay_pipeline_.get());
+      vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, overlay_pipeline_.layout.get(), 0, 1,
+                              &overlay_set_, 0, nullptr);
+      for (const SceneView& view : v) {
+        set_view(pc.cmd, view);
+        const OverlayPush push{view.view_projection,
+                               glm::vec4(static_cast<float>(view.width), static_cast<float>(view.height), 0, 0)};
+        vkCmdPushConstants(pc.cmd, overlay_pipeline_.layout.get(), kStages, 0, sizeof(push), &push);
+        vkCmdDraw(pc.cmd, 6 * segment_count_, 1, 0, 0);
+      }
+    });
+  }
+  return color;
+}
+
+Image MeshRenderer::render(std::uint32_t width, std::uint32_t height, std::span<const SceneView> views,
+                           glm::vec3 background) {
+  const VkDeviceSize bytes = VkDeviceSize{width} * height * 4;
+  vk::Buffer readback = vk::create_buffer(ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+  vk::RenderGraph graph;
+  const vk::ImageHandle color = add_passes(graph, width, height, views, background);
+  auto rb = graph.import_buffer("figure.readback", bytes, {readback.get()});
+  auto copy = graph.add_pass("figure.readback", vk::PassKind::Transfer);
+  copy.transfer_src(color);
+  rb = copy.transfer_dst(rb);
+  copy.side_effect();
+  copy.execute([color, rb, width, height](vk::PassContext& pc) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {width, height, 1};
+    vkCmdCopyImageToBuffer(pc.cmd, pc.image(color), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.buffer(rb), 1,
+                           &region);
+  });
+  vk::execute(ctx_, graph.compile(), transients_);
+
+  Image img;
+  img.width = static_cast<int>(width);
+  img.height = static_cast<int>(height);
+  img.rgba.resize(bytes);
+  std::memcpy(img.rgba.data(), readback.mapped(), bytes);
+  return img;
+}
+
+}  // namespace sdfkit::render
