@@ -1,9 +1,13 @@
 // sdfkit OpenCL kernels, part 2: tracing rays through the octree (engine's octree.hpp layout).
 //
-// Nodes: uint2 (first, mask); mask bit 31 = leaf, then mask & 0x7fffffff triangles from
-// refs[first]; else bits 0..7 name the stored octants, child k at first + popcount(mask below k).
-// Cells: float4 (min corner xyz, side w). Faces: three float4 per face (v0, e1 = v1 - v0,
-// e2 = v2 - v0) whose w components hold the outward unit normal.
+// Nodes: uint2 (first, mask); mask bit 31 = leaf, then mask & 0x7fffffff triangle records from
+// record first; else bits 0..7 name the stored octants, child k at first + popcount(mask below
+// k). Cells: float4 (min corner xyz, side w). Triangle records, in leaf order (a triangle in
+// several leaves has a record in each, so a leaf's triangles are contiguous in memory): three
+// float4 (v0, e1 = v1 - v0, e2 = v2 - v0) whose w components hold the outward unit normal.
+//
+// Tracing may contract a*b+c into fma: hit distances need not round like any other code.
+#pragma OPENCL FP_CONTRACT ON
 //
 // Traversal (after Laine & Karras 2010): the ray's octant mask mirrors the child order, so
 // visiting octants j ^ mask for j = 0..7 is front to back for any ray; each internal node pushes
@@ -12,10 +16,10 @@
 
 #define LEAF_BIT 0x80000000u
 
-// Moller-Trumbore: updates (*best_t, *best_f) when face f is hit at 0 < t < *best_t.
-inline void hit_triangle(__global const float4* faces, uint f, float3 o, float3 d,
+// Moller-Trumbore: updates (*best_t, *best_f) when record f is hit at 0 < t < *best_t.
+inline void hit_triangle(__global const float4* tris, uint f, float3 o, float3 d,
                          float* best_t, uint* best_f) {
-  const float3 v0 = faces[3 * f].xyz, e1 = faces[3 * f + 1].xyz, e2 = faces[3 * f + 2].xyz;
+  const float3 v0 = tris[3 * f].xyz, e1 = tris[3 * f + 1].xyz, e2 = tris[3 * f + 2].xyz;
   const float3 pv = cross(d, e2);
   const float det = dot(e1, pv);
   if (det == 0.0f) return;
@@ -33,10 +37,9 @@ inline void hit_triangle(__global const float4* faces, uint f, float3 o, float3 
   }
 }
 
-// Closest hit of the ray o + t d (t > 0): returns the face or 0xffffffff, and its t.
+// Closest hit of the ray o + t d (t > 0): returns the triangle record or 0xffffffff, and t.
 inline uint closest_hit(__global const uint2* nodes, __global const float4* cells,
-                        __global const uint* refs, __global const float4* faces, float3 o,
-                        float3 d, float* t_out) {
+                        __global const float4* tris, float3 o, float3 d, float* t_out) {
   const float tiny = 1e-20f;
   const float3 dd = (float3)(fabs(d.x) < tiny ? copysign(tiny, d.x) : d.x,
                              fabs(d.y) < tiny ? copysign(tiny, d.y) : d.y,
@@ -73,7 +76,7 @@ inline uint closest_hit(__global const uint2* nodes, __global const float4* cell
     const uint2 nd = nodes[node];
     if (nd.y & LEAF_BIT) {
       const uint end = nd.x + (nd.y & ~LEAF_BIT);
-      for (uint k = nd.x; k < end; ++k) hit_triangle(faces, refs[k], o, d, &best_t, &best_f);
+      for (uint k = nd.x; k < end; ++k) hit_triangle(tris, k, o, d, &best_t, &best_f);
       continue;
     }
     const float4 c = cells[node];
@@ -105,8 +108,7 @@ inline uint closest_hit(__global const uint2* nodes, __global const float4* cell
 // points: xyz = surface point, w = 1 when the point casts rays; normals: xyz = outward unit
 // normal. Writes keys[g] = (bits of the accepted length << 32) | ray index, or NO_HIT_KEY.
 __kernel void trace_rays(__global const uint2* nodes, __global const float4* cells,
-                         __global const uint* refs, __global const float4* faces,
-                         __global const float4* points, __global const float4* normals,
+                         __global const float4* tris, __global const float4* points, __global const float4* normals,
                          __global const float4* table, int n_rays, uint n_points,
                          float origin_offset, int rule, __global ulong* keys) {
   const uint g = get_global_id(0);
@@ -119,9 +121,9 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
     const float3 d = ray_direction(n, table[r].xyz);
     const float3 o = pt.xyz - origin_offset * n;
     float t;
-    const uint f = closest_hit(nodes, cells, refs, faces, o, d, &t);
+    const uint f = closest_hit(nodes, cells, tris, o, d, &t);
     if (f != 0xffffffffu) {
-      const float3 hn = (float3)(faces[3 * f].w, faces[3 * f + 1].w, faces[3 * f + 2].w);
+      const float3 hn = (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
       // Paper: drop hits facing the same way as the start normal; Cgal: keep exits only.
       const bool accept = rule == 0 ? dot(hn, n) <= 0.0f : dot(d, hn) > 0.0f;
       if (accept) key = ((ulong)as_uint(t) << 32) | (ulong)r;

@@ -122,7 +122,7 @@ struct OpenClBackend::Impl {
   Mesh mesh;
   bool has_mesh = false;
   Octree octree;
-  detail::Buffer nodes, cells, refs, faces;
+  detail::Buffer nodes, cells, tris;
   std::size_t geometry_bytes = 0;
 
   // The cone table of the last (rays, cone) and the per-batch buffers.
@@ -228,14 +228,16 @@ void OpenClBackend::Impl::run(cl_kernel kernel, std::size_t items, std::size_t l
 void OpenClBackend::Impl::rebuild_geometry() {
   auto start = std::chrono::steady_clock::now();
   octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
+  // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w.
   const std::vector<glm::vec3> normals_f = face_normals(mesh);
-  std::vector<glm::vec4> face_data(3 * mesh.triangles.size());
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+  std::vector<glm::vec4> records(3 * octree.refs.size());
+  for (std::size_t k = 0; k < octree.refs.size(); ++k) {
+    const std::uint32_t f = octree.refs[k];
     const auto& t = mesh.triangles[f];
     const glm::vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
-    face_data[3 * f] = glm::vec4(a, normals_f[f].x);
-    face_data[3 * f + 1] = glm::vec4(b - a, normals_f[f].y);
-    face_data[3 * f + 2] = glm::vec4(c - a, normals_f[f].z);
+    records[3 * k] = glm::vec4(a, normals_f[f].x);
+    records[3 * k + 1] = glm::vec4(b - a, normals_f[f].y);
+    records[3 * k + 2] = glm::vec4(c - a, normals_f[f].z);
   }
   octree_ms = ms_since(start);
 
@@ -244,15 +246,13 @@ void OpenClBackend::Impl::rebuild_geometry() {
   const cl_context ctx = context.get();
   nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
   cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
-  refs.reserve(ctx, bytes_of(octree.refs), CL_MEM_READ_ONLY, "octree triangle lists");
-  faces.reserve(ctx, bytes_of(face_data), CL_MEM_READ_ONLY, "triangles");
+  tris.reserve(ctx, bytes_of(records), CL_MEM_READ_ONLY, "triangles");
   write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
   write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
-  write(refs.get(), bytes_of(octree.refs), octree.refs.data(), "octree triangle lists");
-  write(faces.get(), bytes_of(face_data), face_data.data(), "triangles");
+  write(tris.get(), bytes_of(records), records.data(), "triangles");
   finish("uploading the mesh");
   upload_ms = ms_since(start);
-  geometry_bytes = nodes.size() + cells.size() + refs.size() + faces.size();
+  geometry_bytes = nodes.size() + cells.size() + tris.size();
 }
 
 void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
@@ -359,8 +359,8 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
     const auto count32 = static_cast<cl_uint>(count);
     m.write(m.points.get(), count * sizeof(cl_float4), &pts[first], "query points");
     m.write(m.normals.get(), count * sizeof(cl_float4), &nrm[first], "query normals");
-    set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.refs.get(),
-             m.faces.get(), m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
+    set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.tris.get(),
+             m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
              query.origin_offset, rule, m.keys.get());
     m.run(m.k_trace.get(), count * nr, m.config.work_group_size, "trace_rays");
     set_args(m.k_gather.get(), "gather_points", m.keys.get(), cl_int{rays}, count32,

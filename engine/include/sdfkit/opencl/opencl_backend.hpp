@@ -7,7 +7,8 @@
 // and the uploaded geometry, so a caller that moves vertices (update_positions) and computes
 // again pays only the octree rebuild, the re-upload and the tracing.
 //
-// Device memory: the geometry (per face 64 bytes + the octree) stays resident; the per-point
+// Device memory: the geometry (48 bytes per leaf reference of a triangle + 24 bytes per octree
+// node) stays resident; the per-point
 // buffers (inputs, one 8-byte key per ray, outputs) are sized to fit OpenClConfig::memory_cap,
 // and the points are processed in as many batches as that takes.
 
