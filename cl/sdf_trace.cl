@@ -104,7 +104,84 @@ inline uint closest_hit(__global const uint2* nodes, __global const float4* cell
   return best_f;
 }
 
+// BVH (SDFKIT_BVH): nodes are two float4, (min xyz, word) and (max xyz, count word). Internal:
+// the first child is the next node, the word names the second; leaf: count word = LEAF_BIT | n,
+// word = first triangle record. Children are visited nearer first; the walk pops only nodes
+// that start before the closest hit so far.
+#ifndef BVH_STACK_SIZE
+#define BVH_STACK_SIZE 96
+#endif
+
+// Slab test of a box against the ray within [0, t_max]: entry distance, or -1 on a miss.
+inline float box_entry(float4 lo, float4 hi, float3 o, float3 inv, float t_max) {
+  const float3 t0 = (lo.xyz - o) * inv, t1 = (hi.xyz - o) * inv;
+  const float3 tn = fmin(t0, t1), tf = fmax(t0, t1);
+  const float tin = fmax(fmax(fmax(tn.x, tn.y), tn.z), 0.0f);
+  const float tout = fmin(fmin(fmin(tf.x, tf.y), tf.z), t_max);
+  return tin <= tout ? tin : -1.0f;
+}
+
+inline uint closest_hit_bvh(__global const float4* bvh, __global const float4* tris, float3 o,
+                            float3 d, float* t_out) {
+  const float tiny = 1e-20f;
+  const float3 dd = (float3)(fabs(d.x) < tiny ? copysign(tiny, d.x) : d.x,
+                             fabs(d.y) < tiny ? copysign(tiny, d.y) : d.y,
+                             fabs(d.z) < tiny ? copysign(tiny, d.z) : d.z);
+  const float3 inv = 1.0f / dd;
+  float best_t = INFINITY;
+  uint best_f = 0xffffffffu;
+  *t_out = best_t;
+  if (box_entry(bvh[0], bvh[1], o, inv, best_t) < 0.0f) return best_f;
+  uint stack_node[BVH_STACK_SIZE];
+  float stack_t[BVH_STACK_SIZE];
+  int sp = 0;
+  uint node = 0;
+  for (;;) {
+    const float4 lo = bvh[2 * node], hi = bvh[2 * node + 1];
+    const uint word = as_uint(lo.w), count = as_uint(hi.w);
+    bool descend = false;
+    if (count & LEAF_BIT) {
+      const uint end = word + (count & ~LEAF_BIT);
+      for (uint k = word; k < end; ++k) hit_triangle(tris, k, o, d, &best_t, &best_f);
+    } else {
+      const uint a = node + 1, b = word;
+      const float ta = box_entry(bvh[2 * a], bvh[2 * a + 1], o, inv, best_t);
+      const float tb = box_entry(bvh[2 * b], bvh[2 * b + 1], o, inv, best_t);
+      if (ta >= 0.0f && tb >= 0.0f) {
+        const bool a_first = ta <= tb;
+        node = a_first ? a : b;
+        if (sp < BVH_STACK_SIZE) {
+          stack_node[sp] = a_first ? b : a;
+          stack_t[sp] = a_first ? tb : ta;
+          ++sp;
+        }
+        descend = true;
+      } else if (ta >= 0.0f) {
+        node = a;
+        descend = true;
+      } else if (tb >= 0.0f) {
+        node = b;
+        descend = true;
+      }
+    }
+    if (descend) continue;
+    // Pop the nearest pending node that still starts before the closest hit.
+    for (;;) {
+      if (sp == 0) {
+        *t_out = best_t;
+        return best_f;
+      }
+      --sp;
+      if (stack_t[sp] < best_t) {
+        node = stack_node[sp];
+        break;
+      }
+    }
+  }
+}
+
 // One work item per ray, point-major (the rays of a point in neighbouring work items).
+// Octree: nodes + cells; BVH (SDFKIT_BVH): cells holds the BVH's float4 pairs, nodes is unused.
 // points: xyz = surface point, w = 1 when the point casts rays; normals: xyz = outward unit
 // normal. Writes keys[g] = (bits of the accepted length << 32) | ray index, or NO_HIT_KEY.
 __kernel void trace_rays(__global const uint2* nodes, __global const float4* cells,
@@ -121,7 +198,11 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
     const float3 d = ray_direction(n, table[r].xyz);
     const float3 o = pt.xyz - origin_offset * n;
     float t;
+#ifdef SDFKIT_BVH
+    const uint f = closest_hit_bvh(cells, tris, o, d, &t);
+#else
     const uint f = closest_hit(nodes, cells, tris, o, d, &t);
+#endif
     if (f != 0xffffffffu) {
       const float3 hn = (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
       // Paper: drop hits facing the same way as the start normal; Cgal: keep exits only.

@@ -3,6 +3,7 @@
 // (update_positions + compute) against the first (set_mesh + compute), peak memory.
 //
 //   sdfkit-opencl-bench [--rays 25,30] [--domain vertex|face] [--device SEL] [--no-embree]
+//                       [--accel bvh|octree] [--bvh-leaf L]
 //                       [--repeats N] [--depth D] [--leaf L] [--wg N] [--tube RINGS,SEGMENTS]
 //                       [--json FILE] MESH...
 //
@@ -141,6 +142,9 @@ int main(int argc, char** argv) {
   app.add_option("--domain", domain, "vertex or face")->check(CLI::IsMember({"vertex", "face"}));
   app.add_option("--device", config.device, "OpenCL device: index or name substring");
   app.add_option("--repeats", repeats, "Warm update_positions + compute calls");
+  std::string accel = "bvh";
+  app.add_option("--accel", accel, "bvh or octree")->check(CLI::IsMember({"bvh", "octree"}));
+  app.add_option("--bvh-leaf", config.bvh_leaf_size, "BVH leaf triangle limit");
   app.add_option("--depth", config.octree_max_depth, "Octree max depth");
   app.add_option("--leaf", config.octree_leaf_size, "Octree leaf triangle limit");
   app.add_option("--wg", config.work_group_size, "Trace work-group size (0 = driver)");
@@ -149,6 +153,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-embree", no_embree, "Skip the Embree reference");
   app.add_option("--json", json_path, "Write the results as JSON");
   CLI11_PARSE(app, argc, argv);
+  config.accel = accel == "octree" ? cl::Accel::Octree : cl::Accel::Bvh;
 
   struct Named {
     std::string name;
@@ -174,7 +179,7 @@ int main(int argc, char** argv) {
       o.rays = rays;
       o.domain = domain == "face" ? SdfDomain::Face : SdfDomain::Vertex;
       std::vector<std::pair<std::string, std::function<std::unique_ptr<SdfBackend>()>>> makers;
-      makers.emplace_back("opencl", [&] { return std::make_unique<cl::OpenClBackend>(config); });
+      makers.emplace_back("opencl-" + accel, [&] { return std::make_unique<cl::OpenClBackend>(config); });
 #if SDFKIT_BENCH_HAS_EMBREE
       if (!no_embree)
         makers.emplace_back("embree", [] { return std::make_unique<reference::EmbreeBackend>(); });

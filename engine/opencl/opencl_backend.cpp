@@ -122,6 +122,7 @@ struct OpenClBackend::Impl {
   Mesh mesh;
   bool has_mesh = false;
   Octree octree;
+  Bvh bvh;
   detail::Buffer nodes, cells, tris;
   std::size_t geometry_bytes = 0;
 
@@ -182,6 +183,7 @@ void OpenClBackend::Impl::build_program() {
   // A node pops one entry and pushes at most 8 children: 7 per level plus the root.
   const int stack = 7 * std::max(config.octree_max_depth, 1) + 2;
   std::string options = "-cl-std=CL1.2 -DSTACK_SIZE=" + std::to_string(stack);
+  if (config.accel == Accel::Bvh) options += " -DSDFKIT_BVH=1";
   cl_device_fp_config fp = 0;
   check(clGetDeviceInfo(device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, nullptr),
         "querying the device's float support");
@@ -227,12 +229,20 @@ void OpenClBackend::Impl::run(cl_kernel kernel, std::size_t items, std::size_t l
 // only grow, so moving vertices reuses the allocations.
 void OpenClBackend::Impl::rebuild_geometry() {
   auto start = std::chrono::steady_clock::now();
-  octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
+  // The triangle list of the leaves, leaf by leaf (octree: a triangle once per leaf it touches).
+  const std::vector<std::uint32_t>* order = nullptr;
+  if (config.accel == Accel::Bvh) {
+    bvh = build_bvh(mesh, BvhParams{config.bvh_leaf_size});
+    order = &bvh.order;
+  } else {
+    octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
+    order = &octree.refs;
+  }
   // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w.
   const std::vector<glm::vec3> normals_f = face_normals(mesh);
-  std::vector<glm::vec4> records(3 * octree.refs.size());
-  for (std::size_t k = 0; k < octree.refs.size(); ++k) {
-    const std::uint32_t f = octree.refs[k];
+  std::vector<glm::vec4> records(3 * order->size());
+  for (std::size_t k = 0; k < order->size(); ++k) {
+    const std::uint32_t f = (*order)[k];
     const auto& t = mesh.triangles[f];
     const glm::vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
     records[3 * k] = glm::vec4(a, normals_f[f].x);
@@ -244,11 +254,18 @@ void OpenClBackend::Impl::rebuild_geometry() {
   start = std::chrono::steady_clock::now();
   const auto bytes_of = [](const auto& v) { return v.size() * sizeof(v[0]); };
   const cl_context ctx = context.get();
-  nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
-  cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
+  if (config.accel == Accel::Bvh) {
+    // The BVH's nodes travel in `cells` (float4 pairs); `nodes` is a placeholder argument.
+    cells.reserve(ctx, bytes_of(bvh.nodes), CL_MEM_READ_ONLY, "BVH nodes");
+    nodes.reserve(ctx, 16, CL_MEM_READ_ONLY, "unused octree nodes");
+    write(cells.get(), bytes_of(bvh.nodes), bvh.nodes.data(), "BVH nodes");
+  } else {
+    nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
+    cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
+    write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
+    write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
+  }
   tris.reserve(ctx, bytes_of(records), CL_MEM_READ_ONLY, "triangles");
-  write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
-  write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
   write(tris.get(), bytes_of(records), records.data(), "triangles");
   finish("uploading the mesh");
   upload_ms = ms_since(start);
@@ -284,6 +301,7 @@ std::string OpenClBackend::device_name() const {
 
 const DeviceInfo& OpenClBackend::device() const { return impl_->info; }
 const Octree& OpenClBackend::octree() const { return impl_->octree; }
+const Bvh& OpenClBackend::bvh() const { return impl_->bvh; }
 
 void OpenClBackend::set_mesh(const Mesh& mesh) {
   validate_mesh(mesh, "the mesh given to the OpenCL backend");
@@ -382,7 +400,7 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
 }
 
 std::vector<StageTiming> OpenClBackend::last_timings() const {
-  return {{"octree_build", impl_->octree_ms},
+  return {{impl_->config.accel == Accel::Bvh ? "bvh_build" : "octree_build", impl_->octree_ms},
           {"upload", impl_->upload_ms},
           {"trace_gather", impl_->trace_ms}};
 }

@@ -11,12 +11,17 @@ bool no_device_allowed() {
   return v != nullptr && std::string(v) == "1";
 }
 
-cl::OpenClBackend* opencl_backend() {
-  static std::unique_ptr<cl::OpenClBackend> backend = [] {
-    if (cl::list_devices().empty()) return std::unique_ptr<cl::OpenClBackend>();
-    return std::make_unique<cl::OpenClBackend>();
-  }();
-  return backend.get();
+cl::OpenClBackend* opencl_backend(cl::Accel accel) {
+  static const bool has_device = !cl::list_devices().empty();
+  static std::unique_ptr<cl::OpenClBackend> backends[2];
+  if (!has_device) return nullptr;
+  auto& b = backends[accel == cl::Accel::Bvh ? 0 : 1];
+  if (!b) {
+    cl::OpenClConfig config;
+    config.accel = accel;
+    b = std::make_unique<cl::OpenClBackend>(config);
+  }
+  return b.get();
 }
 
 }  // namespace sdfkit::test

@@ -8,16 +8,17 @@
 
 namespace sdfkit::test {
 
-// The shared backend, or nullptr when no device exists (then the caller has already been
-// failed or skipped: use SDFKIT_REQUIRE_CL).
-cl::OpenClBackend* opencl_backend();
+// The shared backend with the given acceleration structure, or nullptr when no device exists
+// (use SDFKIT_REQUIRE_CL / SDFKIT_REQUIRE_CL_ACCEL, which fail or skip the test then).
+cl::OpenClBackend* opencl_backend(cl::Accel accel = cl::Accel::Bvh);
 
 }  // namespace sdfkit::test
 
 // Binds `var` to the shared backend; fails (or skips, with SDFKIT_ALLOW_NO_DEVICE=1) the test
 // when there is no OpenCL device.
-#define SDFKIT_REQUIRE_CL(var)                                            \
-  cl::OpenClBackend* var##_ptr = ::sdfkit::test::opencl_backend();        \
+#define SDFKIT_REQUIRE_CL(var) SDFKIT_REQUIRE_CL_ACCEL(var, cl::Accel::Bvh)
+#define SDFKIT_REQUIRE_CL_ACCEL(var, accel)                               \
+  cl::OpenClBackend* var##_ptr = ::sdfkit::test::opencl_backend(accel);   \
   if (var##_ptr == nullptr) {                                             \
     if (::sdfkit::test::no_device_allowed())                              \
       GTEST_SKIP() << "no OpenCL device (SDFKIT_ALLOW_NO_DEVICE=1)";      \

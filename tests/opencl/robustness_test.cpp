@@ -125,8 +125,10 @@ TEST(OpenClRobustness, NoHitsAtAllAreFilled) {
   }
 }
 
-TEST(OpenClRobustness, UpdatePositionsEqualsFreshSetMesh) {
-  SDFKIT_REQUIRE_CL(backend);
+class OpenClUpdate : public ::testing::TestWithParam<cl::Accel> {};
+
+TEST_P(OpenClUpdate, UpdatePositionsEqualsFreshSetMesh) {
+  SDFKIT_REQUIRE_CL_ACCEL(backend, GetParam());
   const Mesh before = shapes::capsule(1.0f, 3.0f, 40, 20);
   Mesh after = before;
   for (glm::vec3& p : after.positions)
@@ -142,6 +144,9 @@ TEST(OpenClRobustness, UpdatePositionsEqualsFreshSetMesh) {
   EXPECT_EQ(moved.kept_rays, fresh.kept_rays);
   EXPECT_THROW(backend.update_positions(std::vector<glm::vec3>(3)), Error);
 }
+
+INSTANTIATE_TEST_SUITE_P(Accel, OpenClUpdate, ::testing::Values(cl::Accel::Bvh, cl::Accel::Octree),
+                         [](const auto& p) { return p.param == cl::Accel::Bvh ? "Bvh" : "Octree"; });
 
 TEST(OpenClRobustness, SmallMemoryCapBatchesWithoutChangingResults) {
   SDFKIT_REQUIRE_CL(shared);
