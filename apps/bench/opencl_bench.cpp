@@ -145,6 +145,8 @@ int main(int argc, char** argv) {
   std::string accel = "bvh";
   app.add_option("--accel", accel, "bvh or octree")->check(CLI::IsMember({"bvh", "octree"}));
   app.add_option("--bvh-leaf", config.bvh_leaf_size, "BVH leaf triangle limit");
+  bool no_packets = false;
+  app.add_flag("--no-packets", no_packets, "BVH: one ray per work item instead of packets of 8");
   app.add_option("--depth", config.octree_max_depth, "Octree max depth");
   app.add_option("--leaf", config.octree_leaf_size, "Octree leaf triangle limit");
   app.add_option("--wg", config.work_group_size, "Trace work-group size (0 = driver)");
@@ -154,6 +156,8 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_path, "Write the results as JSON");
   CLI11_PARSE(app, argc, argv);
   config.accel = accel == "octree" ? cl::Accel::Octree : cl::Accel::Bvh;
+  config.bvh_packets = !no_packets;
+  if (accel == "bvh" && no_packets) accel = "bvh-single";
 
   struct Named {
     std::string name;

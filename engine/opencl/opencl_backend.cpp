@@ -116,7 +116,7 @@ struct OpenClBackend::Impl {
   detail::Context context;
   detail::Queue queue;
   detail::Program program;
-  detail::Kernel k_cone, k_trace, k_gather, k_dirs;
+  detail::Kernel k_cone, k_trace, k_packets, k_gather, k_dirs;
 
   // Geometry (resident between computes).
   Mesh mesh;
@@ -171,6 +171,7 @@ void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
   build_program();
   k_cone = make_kernel("make_cone");
   k_trace = make_kernel("trace_rays");
+  if (cfg.accel == Accel::Bvh) k_packets = make_kernel("trace_packets");
   k_gather = make_kernel("gather_points");
   k_dirs = make_kernel("ray_directions");
 }
@@ -377,10 +378,20 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
     const auto count32 = static_cast<cl_uint>(count);
     m.write(m.points.get(), count * sizeof(cl_float4), &pts[first], "query points");
     m.write(m.normals.get(), count * sizeof(cl_float4), &nrm[first], "query normals");
-    set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.tris.get(),
-             m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
-             query.origin_offset, rule, m.keys.get());
-    m.run(m.k_trace.get(), count * nr, m.config.work_group_size, "trace_rays");
+    if (m.config.accel == Accel::Bvh && m.config.bvh_packets) {
+      // Packets of kPacket rays of one point per work item (cl/sdf_trace.cl).
+      constexpr std::size_t kPacket = 8;
+      set_args(m.k_packets.get(), "trace_packets", m.cells.get(), m.tris.get(), m.points.get(),
+               m.normals.get(), m.table.get(), cl_int{rays}, count32, query.origin_offset, rule,
+               m.keys.get());
+      m.run(m.k_packets.get(), count * ((nr + kPacket - 1) / kPacket), m.config.work_group_size,
+            "trace_packets");
+    } else {
+      set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.tris.get(),
+               m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
+               query.origin_offset, rule, m.keys.get());
+      m.run(m.k_trace.get(), count * nr, m.config.work_group_size, "trace_rays");
+    }
     set_args(m.k_gather.get(), "gather_points", m.keys.get(), cl_int{rays}, count32,
              m.table.get(), m.values.get(), m.kept.get());
     m.run(m.k_gather.get(), count, 0, "gather_points");

@@ -56,6 +56,9 @@ struct OpenClConfig {
   int octree_leaf_size = 8;
   // BVH: the triangle count under which the SAH may stop splitting.
   int bvh_leaf_size = 4;
+  // BVH: trace 8 rays of a point together as one vector packet per work item (SIMD on CPU
+  // devices) instead of one ray per work item.
+  bool bvh_packets = true;
   // Work-group size of the trace kernel; 0 lets the driver choose.
   std::size_t work_group_size = 0;
 };
