@@ -327,18 +327,24 @@ inline void closest_hits_packet(__global const float4* bvh, __global const float
 }
 
 // One work item per PACKET consecutive rays of one point; writes their keys like trace_rays.
+// `order` lists the ray indices slot by slot (the host groups rays of similar azimuth into
+// the same packet, so a packet's rays stay close together).
 __kernel void trace_packets(__global const float4* bvh, __global const float4* tris,
                             __global const float4* points, __global const float4* normals,
-                            __global const float4* table, int n_rays, uint n_points,
-                            float origin_offset, int rule, __global ulong* keys) {
+                            __global const float4* table, __global const uint* order,
+                            int n_rays, uint n_points, float origin_offset, int rule,
+                            __global ulong* keys) {
+  // ceil(n / PACKET) packets per point, the rays spread evenly over them (25 rays: 7+6+6+6,
+  // not 8+8+8+1), so every packet is a wedge of about the same width.
   const uint packets = ((uint)n_rays + PACKET - 1) / PACKET;
+  const uint per = ((uint)n_rays + packets - 1) / packets;
   const uint g = get_global_id(0);
   if (g >= n_points * packets) return;
-  const uint p = g / packets, first = (g - p * packets) * PACKET;
+  const uint p = g / packets, first = (g - p * packets) * per;
   const float4 pt = points[p];
-  const uint lanes = min((uint)PACKET, (uint)n_rays - first);
+  const uint lanes = min(per, (uint)n_rays - first);
   if (pt.w == 0.0f) {
-    for (uint l = 0; l < lanes; ++l) keys[(size_t)p * n_rays + first + l] = NO_HIT_KEY;
+    for (uint l = 0; l < lanes; ++l) keys[(size_t)p * n_rays + order[first + l]] = NO_HIT_KEY;
     return;
   }
   const float3 n = normals[p].xyz;
@@ -346,7 +352,7 @@ __kernel void trace_packets(__global const float4* bvh, __global const float4* t
   float dxs[PACKET], dys[PACKET], dzs[PACKET];
   int act[PACKET];
   for (uint l = 0; l < PACKET; ++l) {
-    const float3 d = ray_direction(n, table[first + min(l, lanes - 1)].xyz);
+    const float3 d = ray_direction(n, table[order[first + min(l, lanes - 1)]].xyz);
     dxs[l] = d.x;
     dys[l] = d.y;
     dzs[l] = d.z;
@@ -362,15 +368,16 @@ __kernel void trace_packets(__global const float4* bvh, __global const float4* t
   vstore8(f8, 0, fs);
   vstore8(t8, 0, ts);
   for (uint l = 0; l < lanes; ++l) {
+    const uint r = order[first + l];
     ulong key = NO_HIT_KEY;
     const uint f = fs[l];
     if (f != 0xffffffffu) {
       const float3 hn = (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
       const float3 d = (float3)(dxs[l], dys[l], dzs[l]);
       const bool accept = rule == 0 ? dot(hn, n) <= 0.0f : dot(d, hn) > 0.0f;
-      if (accept) key = ((ulong)as_uint(ts[l]) << 32) | (ulong)(first + l);
+      if (accept) key = ((ulong)as_uint(ts[l]) << 32) | (ulong)r;
     }
-    keys[(size_t)p * n_rays + first + l] = key;
+    keys[(size_t)p * n_rays + r] = key;
   }
 }
 #endif

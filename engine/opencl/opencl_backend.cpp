@@ -127,7 +127,7 @@ struct OpenClBackend::Impl {
   std::size_t geometry_bytes = 0;
 
   // The cone table of the last (rays, cone) and the per-batch buffers.
-  detail::Buffer table;
+  detail::Buffer table, ray_order;
   int table_rays = 0;
   float table_cone = 0.0f;
   detail::Buffer points, normals, keys, values, kept;
@@ -286,6 +286,20 @@ void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
   const cl_mem t = table.get();
   set_args(k_cone.get(), "make_cone", cl_int{rays}, one_minus_cos, f_hi, f_lo, t);
   run(k_cone.get(), static_cast<std::size_t>(rays), 0, "make_cone");
+  // Packet order: the rays sorted by azimuth (phi_i = i * golden angle), so each packet of
+  // consecutive slots is a wedge of the cone whose rays meet nearby triangles. Only the order
+  // in which rays are traced changes; every ray keeps its index and weight.
+  std::vector<cl_uint> order(static_cast<std::size_t>(rays));
+  std::vector<double> phi(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = static_cast<cl_uint>(i);
+    phi[i] = std::fmod(static_cast<double>(i) * kGoldenAngle, 2.0 * M_PI);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](cl_uint a, cl_uint b) { return phi[a] < phi[b]; });
+  ray_order.reserve(context.get(), order.size() * sizeof(cl_uint), CL_MEM_READ_ONLY, "the ray order");
+  check(clEnqueueWriteBuffer(queue.get(), ray_order.get(), CL_TRUE, 0, order.size() * sizeof(cl_uint),
+                             order.data(), 0, nullptr, nullptr),
+        "uploading the ray order");
   table_rays = rays;
   table_cone = cone_degrees;
 }
@@ -382,7 +396,7 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
       // Packets of kPacket rays of one point per work item (cl/sdf_trace.cl).
       constexpr std::size_t kPacket = 8;
       set_args(m.k_packets.get(), "trace_packets", m.cells.get(), m.tris.get(), m.points.get(),
-               m.normals.get(), m.table.get(), cl_int{rays}, count32, query.origin_offset, rule,
+               m.normals.get(), m.table.get(), m.ray_order.get(), cl_int{rays}, count32, query.origin_offset, rule,
                m.keys.get());
       m.run(m.k_packets.get(), count * ((nr + kPacket - 1) / kPacket), m.config.work_group_size,
             "trace_packets");
