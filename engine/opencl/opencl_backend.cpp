@@ -117,6 +117,7 @@ struct OpenClBackend::Impl {
   detail::Queue queue;
   detail::Program program;
   detail::Kernel k_cone, k_trace, k_packets, k_gather, k_dirs;
+  bool packets = false;  // BVH traced by trace_packets
 
   // Geometry (resident between computes).
   Mesh mesh;
@@ -171,7 +172,8 @@ void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
   build_program();
   k_cone = make_kernel("make_cone");
   k_trace = make_kernel("trace_rays");
-  if (cfg.accel == Accel::Bvh) k_packets = make_kernel("trace_packets");
+  packets = cfg.accel == Accel::Bvh && cfg.bvh_packets.value_or(info.type == "CPU");
+  if (packets) k_packets = make_kernel("trace_packets");
   k_gather = make_kernel("gather_points");
   k_dirs = make_kernel("ray_directions");
 }
@@ -392,7 +394,7 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
     const auto count32 = static_cast<cl_uint>(count);
     m.write(m.points.get(), count * sizeof(cl_float4), &pts[first], "query points");
     m.write(m.normals.get(), count * sizeof(cl_float4), &nrm[first], "query normals");
-    if (m.config.accel == Accel::Bvh && m.config.bvh_packets) {
+    if (m.packets) {
       // Packets of kPacket rays of one point per work item (cl/sdf_trace.cl).
       constexpr std::size_t kPacket = 8;
       set_args(m.k_packets.get(), "trace_packets", m.cells.get(), m.tris.get(), m.points.get(),

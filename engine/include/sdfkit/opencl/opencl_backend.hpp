@@ -24,6 +24,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -57,8 +58,9 @@ struct OpenClConfig {
   // BVH: the triangle count under which the SAH may stop splitting.
   int bvh_leaf_size = 4;
   // BVH: trace 8 rays of a point together as one vector packet per work item (SIMD on CPU
-  // devices) instead of one ray per work item.
-  bool bvh_packets = true;
+  // devices) instead of one ray per work item. Unset: packets on CPU devices, single rays on
+  // GPUs (whose work items are scalar lanes already).
+  std::optional<bool> bvh_packets;
   // Work-group size of the trace kernel; 0 lets the driver choose.
   std::size_t work_group_size = 0;
 };
