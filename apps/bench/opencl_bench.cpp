@@ -127,7 +127,18 @@ std::size_t peak_rss_bytes() {
 
 }  // namespace sdfkit::bench
 
+int run(int argc, char** argv);
+
 int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sdfkit-opencl-bench: %s\n", e.what());
+    return 1;
+  }
+}
+
+int run(int argc, char** argv) {
   using namespace sdfkit;
   CLI::App app{"Times the OpenCL SDF backend against the Embree reference"};
   std::vector<std::string> meshes;

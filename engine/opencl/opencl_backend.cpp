@@ -3,7 +3,6 @@
 #include "cl_api.hpp"
 
 #include "sdfkit/core/error.hpp"
-#include "sdfkit/core/log.hpp"
 
 #include <glm/vec4.hpp>
 
@@ -11,6 +10,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
