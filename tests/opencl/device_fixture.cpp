@@ -11,14 +11,24 @@ bool no_device_allowed() {
   return v != nullptr && std::string(v) == "1";
 }
 
-cl::OpenClBackend* opencl_backend(cl::Accel accel) {
+const char* tracer_name(Tracer t) {
+  switch (t) {
+    case Tracer::BvhPackets: return "BvhPackets";
+    case Tracer::BvhSingle: return "BvhSingle";
+    case Tracer::Octree: return "Octree";
+  }
+  return "?";
+}
+
+cl::OpenClBackend* opencl_backend(Tracer tracer) {
   static const bool has_device = !cl::list_devices().empty();
-  static std::unique_ptr<cl::OpenClBackend> backends[2];
+  static std::unique_ptr<cl::OpenClBackend> backends[3];
   if (!has_device) return nullptr;
-  auto& b = backends[accel == cl::Accel::Bvh ? 0 : 1];
+  auto& b = backends[static_cast<int>(tracer)];
   if (!b) {
     cl::OpenClConfig config;
-    config.accel = accel;
+    config.accel = tracer == Tracer::Octree ? cl::Accel::Octree : cl::Accel::Bvh;
+    config.bvh_packets = tracer == Tracer::BvhPackets;
     b = std::make_unique<cl::OpenClBackend>(config);
   }
   return b.get();

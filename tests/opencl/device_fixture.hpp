@@ -8,17 +8,22 @@
 
 namespace sdfkit::test {
 
-// The shared backend with the given acceleration structure, or nullptr when no device exists
-// (use SDFKIT_REQUIRE_CL / SDFKIT_REQUIRE_CL_ACCEL, which fail or skip the test then).
-cl::OpenClBackend* opencl_backend(cl::Accel accel = cl::Accel::Bvh);
+// The tracer variants the tests cover: the BVH with packets of 8 rays (the default on CPU
+// devices), the BVH with one ray per work item (the default on GPUs), the octree.
+enum class Tracer { BvhPackets, BvhSingle, Octree };
+const char* tracer_name(Tracer t);
+
+// The shared backend of that variant, or nullptr when no device exists (use SDFKIT_REQUIRE_CL
+// / SDFKIT_REQUIRE_CL_ACCEL, which fail or skip the test then).
+cl::OpenClBackend* opencl_backend(Tracer tracer = Tracer::BvhPackets);
 
 }  // namespace sdfkit::test
 
 // Binds `var` to the shared backend; fails (or skips, with SDFKIT_ALLOW_NO_DEVICE=1) the test
 // when there is no OpenCL device.
-#define SDFKIT_REQUIRE_CL(var) SDFKIT_REQUIRE_CL_ACCEL(var, cl::Accel::Bvh)
-#define SDFKIT_REQUIRE_CL_ACCEL(var, accel)                               \
-  cl::OpenClBackend* var##_ptr = ::sdfkit::test::opencl_backend(accel);   \
+#define SDFKIT_REQUIRE_CL(var) SDFKIT_REQUIRE_CL_ACCEL(var, ::sdfkit::test::Tracer::BvhPackets)
+#define SDFKIT_REQUIRE_CL_ACCEL(var, tracer)                               \
+  cl::OpenClBackend* var##_ptr = ::sdfkit::test::opencl_backend(tracer);   \
   if (var##_ptr == nullptr) {                                             \
     if (::sdfkit::test::no_device_allowed())                              \
       GTEST_SKIP() << "no OpenCL device (SDFKIT_ALLOW_NO_DEVICE=1)";      \

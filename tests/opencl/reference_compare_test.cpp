@@ -31,7 +31,7 @@ Pair run_both(cl::OpenClBackend& backend, const Mesh& mesh, const SdfOptions& o)
 
 }  // namespace
 
-class OpenClVsEmbree : public ::testing::TestWithParam<std::tuple<const char*, cl::Accel>> {};
+class OpenClVsEmbree : public ::testing::TestWithParam<std::tuple<const char*, test::Tracer>> {};
 
 TEST_P(OpenClVsEmbree, ValuesAgreePerVertexAndPerFace) {
   const char* name = std::get<0>(GetParam());
@@ -65,12 +65,13 @@ auto param_name = [](const auto& param_info) {
 };
 
 INSTANTIATE_TEST_SUITE_P(CgalMeshes, OpenClVsEmbree,
-                         ::testing::Values(std::tuple{"elephant.off", cl::Accel::Bvh},
-                                           std::tuple{"cow.off", cl::Accel::Bvh},
-                                           std::tuple{"elephant.off", cl::Accel::Octree}),
+                         ::testing::Values(std::tuple{"elephant.off", test::Tracer::BvhPackets},
+                                           std::tuple{"cow.off", test::Tracer::BvhPackets},
+                                           std::tuple{"elephant.off", test::Tracer::BvhSingle},
+                                           std::tuple{"elephant.off", test::Tracer::Octree}),
                          [](const auto& p) {
-                           std::string s = std::string(std::get<0>(p.param)) +
-                                           (std::get<1>(p.param) == cl::Accel::Bvh ? "_bvh" : "_octree");
+                           std::string s = std::string(std::get<0>(p.param)) + "_" +
+                                           test::tracer_name(std::get<1>(p.param));
                            for (char& c : s)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return s;

@@ -128,7 +128,7 @@ TEST(OpenClRobustness, NoHitsAtAllAreFilled) {
   }
 }
 
-class OpenClUpdate : public ::testing::TestWithParam<cl::Accel> {};
+class OpenClUpdate : public ::testing::TestWithParam<test::Tracer> {};
 
 TEST_P(OpenClUpdate, UpdatePositionsEqualsFreshSetMesh) {
   SDFKIT_REQUIRE_CL_ACCEL(backend, GetParam());
@@ -148,8 +148,8 @@ TEST_P(OpenClUpdate, UpdatePositionsEqualsFreshSetMesh) {
   EXPECT_THROW(backend.update_positions(std::vector<glm::vec3>(3)), Error);
 }
 
-INSTANTIATE_TEST_SUITE_P(Accel, OpenClUpdate, ::testing::Values(cl::Accel::Bvh, cl::Accel::Octree),
-                         [](const auto& p) { return p.param == cl::Accel::Bvh ? "Bvh" : "Octree"; });
+INSTANTIATE_TEST_SUITE_P(Tracer, OpenClUpdate, ::testing::Values(test::Tracer::BvhPackets, test::Tracer::BvhSingle, test::Tracer::Octree),
+                         [](const auto& p) { return std::string(test::tracer_name(p.param)); });
 
 TEST(OpenClRobustness, SmallMemoryCapBatchesWithoutChangingResults) {
   SDFKIT_REQUIRE_CL(shared);

@@ -74,7 +74,7 @@ void expect_closest_hits(cl::OpenClBackend& backend, const Mesh& mesh) {
 
 }  // namespace
 
-class OpenClTrace : public ::testing::TestWithParam<cl::Accel> {};
+class OpenClTrace : public ::testing::TestWithParam<test::Tracer> {};
 
 TEST_P(OpenClTrace, ClosestHitEqualsBruteForceOnARotatedTorus) {
   SDFKIT_REQUIRE_CL_ACCEL(backend, GetParam());
@@ -96,5 +96,5 @@ TEST_P(OpenClTrace, ClosestHitEqualsBruteForceOnCellPlanes) {
   expect_closest_hits(backend, shapes::icosphere(1.0f, 3));
 }
 
-INSTANTIATE_TEST_SUITE_P(Accel, OpenClTrace, ::testing::Values(cl::Accel::Bvh, cl::Accel::Octree),
-                         [](const auto& p) { return p.param == cl::Accel::Bvh ? "Bvh" : "Octree"; });
+INSTANTIATE_TEST_SUITE_P(Tracer, OpenClTrace, ::testing::Values(test::Tracer::BvhPackets, test::Tracer::BvhSingle, test::Tracer::Octree),
+                         [](const auto& p) { return std::string(test::tracer_name(p.param)); });
