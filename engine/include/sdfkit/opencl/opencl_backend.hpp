@@ -9,7 +9,8 @@
 //
 // A backend object is a session: it holds the OpenCL context, the compiled program, its kernels
 // and the uploaded geometry, so a caller that moves vertices (update_positions) and computes
-// again pays only the octree rebuild, the re-upload and the tracing.
+// again pays only the rebuild of the acceleration structure, the re-upload and the tracing.
+// A session is not thread-safe: use one per thread.
 //
 // Device memory: the geometry (48 bytes per leaf reference of a triangle + 24 bytes per octree
 // node) stays resident; the per-point
