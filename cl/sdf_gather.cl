@@ -1,5 +1,7 @@
 // sdfkit OpenCL kernels, part 3: the gather of sdfkit::gather on the device.
 //
+#pragma OPENCL FP_CONTRACT OFF
+
 // Each point's n_rays keys (length bits << 32 | ray index; NO_HIT_KEY = dropped) are sorted in
 // place, which orders them by length and ties by ray index exactly as the C++ definition does
 // (positive floats order like their bit patterns). Then, in float and in sorted order: median =

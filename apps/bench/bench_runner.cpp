@@ -6,8 +6,11 @@
 #include "sdfkit/post/smooth.hpp"
 #include "sdfkit/reference/embree_backend.hpp"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +24,19 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+double cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) / 1e6;
+}
+
+double children_cpu_s() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec) / 1e6;
 }
 
 double median(std::vector<double> v) {
@@ -63,7 +79,8 @@ double stage_ms(const std::vector<StageTiming>& stages, const std::string& prefi
 std::unique_ptr<SdfBackend> make(const std::string& name, const BenchOptions& o, int views, int resolution) {
   if (name == "embree") return std::make_unique<reference::EmbreeBackend>();
   BackendConfig c;
-  c.kind = parse_backend_kind(name);
+  c.kind = parse_backend_kind(name == "opencl-octree" ? "opencl" : name);
+  if (name == "opencl-octree") c.accel = "octree";
   c.device = o.device;
   c.views = views;
   c.resolution = resolution;
@@ -86,14 +103,17 @@ BackendRun time_backend(const std::string& name, const Mesh& mesh, const SdfOpti
     backend->set_mesh(mesh);
     RawSdf raw = backend->compute(query, sdf);
     run.first_ms = ms_since(t0);
-    std::vector<double> warm;
+    std::vector<double> warm, warm_cpu;
     for (int r = 0; r < o.repeats; ++r) {
       t0 = Clock::now();
+      const double c0 = cpu_ms();
       backend->update_positions(mesh.positions);
       raw = backend->compute(query, sdf);
       warm.push_back(ms_since(t0));
+      warm_cpu.push_back(cpu_ms() - c0);
     }
     run.repeat_ms = warm.empty() ? run.first_ms : median(warm);
+    run.repeat_cpu_ms = warm_cpu.empty() ? 0.0 : median(warm_cpu);
     run.stages = backend->last_timings();
     run.device_bytes = backend->device_memory_bytes();
     std::size_t valid = 0;
@@ -205,8 +225,10 @@ MeshResult run_mesh(const BenchMesh& bm, const BenchOptions& o) {
   // The CGAL comparison: per face, 25 rays (sdf_values computes per face).
   if (o.cgal) {
     try {
+      const double c0 = children_cpu_s();
       const std::string out = run_process("'" + o.cgal_helper + "' '" + bm.off_path + "' " + std::to_string(o.cgal_rays));
       r.cgal_seconds = nlohmann::json::parse(out).at("seconds").get<double>();
+      r.cgal_cpu_seconds = children_cpu_s() - c0;
     } catch (const std::exception& e) {
       r.cgal_error = e.what();
     }
@@ -258,7 +280,7 @@ nlohmann::json to_json(const std::vector<MeshResult>& results, const BenchOption
     nlohmann::json jm = {{"mesh", m.name}, {"vertices", m.vertices}, {"faces", m.faces}};
     for (const BackendRun& b : m.runs) {
       nlohmann::json jb = {{"backend", b.backend}, {"device", b.device}, {"mode", b.mode},
-                           {"first_ms", b.first_ms}, {"repeat_ms", b.repeat_ms},
+                           {"first_ms", b.first_ms}, {"repeat_ms", b.repeat_ms}, {"repeat_cpu_ms", b.repeat_cpu_ms},
                            {"rays_per_second", b.rays_per_second}, {"device_bytes", b.device_bytes}};
       nlohmann::json st = nlohmann::json::object();
       for (const auto& s : b.stages) st[s.stage] = s.milliseconds;
@@ -271,6 +293,7 @@ nlohmann::json to_json(const std::vector<MeshResult>& results, const BenchOption
       jm["runs"].push_back(jb);
     }
     if (m.cgal_seconds) jm["cgal_sdf_values_s"] = *m.cgal_seconds;
+    if (m.cgal_cpu_seconds) jm["cgal_process_cpu_s"] = *m.cgal_cpu_seconds;
     if (!m.cgal_error.empty()) jm["cgal_error"] = m.cgal_error;
     if (m.meshlab_seconds) jm["meshlab_sdf_s"] = *m.meshlab_seconds;
     if (!m.meshlab_error.empty()) jm["meshlab_error"] = m.meshlab_error;
@@ -286,10 +309,11 @@ const BackendRun* find_run(const MeshResult& m, const std::string& backend, cons
     if (r.backend == backend && r.mode.rfind(mode_prefix, 0) == 0 && r.error.empty()) return &r;
   return nullptr;
 }
+// "wall (CPU)" seconds of the median warm call.
 std::string fmt_s(const BackendRun* r) {
   if (!r) return "–";
   char b[64];
-  std::snprintf(b, sizeof b, "%.3f", r->repeat_ms / 1000.0);
+  std::snprintf(b, sizeof b, "%.3f (%.3f)", r->repeat_ms / 1000.0, r->repeat_cpu_ms / 1000.0);
   return b;
 }
 std::string fmt(double v, const char* f) {
@@ -302,34 +326,39 @@ std::string fmt(double v, const char* f) {
 std::string to_markdown(const std::vector<MeshResult>& results, const BenchOptions& o) {
   std::ostringstream md;
   md << "SDF per vertex; Vulkan at its default views/resolution, ray backends at " << o.rays
-     << " rays. Times are warm calls (update_positions + compute, median of " << o.repeats
-     << "); cold = first call including set-up.\n\n";
-  md << "| mesh | vertices | faces | Vulkan s | OpenCL s | Embree s | OpenCL Mrays/s | Embree Mrays/s | "
+     << " rays. Times are seconds of a warm call (update_positions + compute, median of " << o.repeats
+     << ") as wall clock (process CPU time, all threads, in brackets).\n\n";
+  md << "| mesh | vertices | faces | Vulkan s | OpenCL BVH s | OpenCL octree s | Embree s | OpenCL Mrays/s | Embree Mrays/s | "
         "OpenCL vs Embree (median rel. / Pearson) | Vulkan vs Embree | smooth k=" << o.smooth_rings << " ms |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|---:|---|---|---:|\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|\n";
   for (const MeshResult& m : results) {
     const auto* vk = find_run(m, "vulkan", "vertex, default");
     const auto* cl = find_run(m, "opencl", "vertex");
+    const auto* oct = find_run(m, "opencl-octree", "vertex");
     const auto* em = find_run(m, "embree", "vertex");
     auto cmp = [](const BackendRun* r) {
       if (!r || !r->vs_reference) return std::string("–");
       return fmt(100 * r->vs_reference->median_relative, "%.2f%%") + " / " + fmt(r->vs_reference->pearson, "%.4f");
     };
     md << "| " << m.name << " | " << m.vertices << " | " << m.faces << " | " << fmt_s(vk) << " | " << fmt_s(cl)
-       << " | " << fmt_s(em) << " | " << (cl ? fmt(cl->rays_per_second / 1e6, "%.2f") : "–") << " | "
+       << " | " << fmt_s(oct) << " | " << fmt_s(em) << " | " << (cl ? fmt(cl->rays_per_second / 1e6, "%.2f") : "–") << " | "
        << (em ? fmt(em->rays_per_second / 1e6, "%.2f") : "–") << " | " << cmp(cl) << " | " << cmp(vk) << " | "
        << (m.smooth_ms ? fmt(*m.smooth_ms, "%.1f") : "–") << " |\n";
   }
   if (o.cgal) {
     md << "\nAgainst CGAL `sdf_values` (per face, " << o.cgal_rays << " rays, one process each):\n\n";
-    md << "| mesh | faces | CGAL s | OpenCL s | Embree s | CGAL / OpenCL |\n|---|---:|---:|---:|---:|---:|\n";
+    md << "| mesh | faces | CGAL s | OpenCL s | Embree s | CGAL / OpenCL (wall) | CGAL / OpenCL (CPU) |\n"
+          "|---|---:|---:|---:|---:|---:|---:|\n";
     for (const MeshResult& m : results) {
       const auto* cl = find_run(m, "opencl", "face");
       const auto* em = find_run(m, "embree", "face");
       md << "| " << m.name << " | " << m.faces << " | "
-         << (m.cgal_seconds ? fmt(*m.cgal_seconds, "%.2f") : "– " + m.cgal_error) << " | " << fmt_s(cl) << " | "
-         << fmt_s(em) << " | "
-         << (m.cgal_seconds && cl ? fmt(*m.cgal_seconds / (cl->repeat_ms / 1000.0), "%.1f×") : "–") << " |\n";
+         << (m.cgal_seconds ? fmt(*m.cgal_seconds, "%.2f") + " (" + fmt(m.cgal_cpu_seconds.value_or(0), "%.2f") + ")"
+                            : "– " + m.cgal_error)
+         << " | " << fmt_s(cl) << " | " << fmt_s(em) << " | "
+         << (m.cgal_seconds && cl ? fmt(*m.cgal_seconds / (cl->repeat_ms / 1000.0), "%.1f×") : "–") << " | "
+         << (m.cgal_cpu_seconds && cl && cl->repeat_cpu_ms > 0 ? fmt(*m.cgal_cpu_seconds / (cl->repeat_cpu_ms / 1000.0), "%.1f×") : "–")
+         << " |\n";
     }
   }
   if (o.meshlab) {

@@ -20,6 +20,7 @@ struct BenchMesh {
 };
 
 struct BenchOptions {
+  // vulkan, opencl (BVH), opencl-octree, embree
   std::vector<std::string> backends = {"vulkan", "opencl", "embree"};
   int rays = 30;             // ray backends' default table
   int cgal_rays = 25;        // the CGAL comparison (per face)
@@ -37,6 +38,7 @@ struct BackendRun {
   std::string backend, device, mode;  // mode: "vertex/30 rays", "face/25 rays", "vertex/128 views 512px"
   double first_ms = 0;       // set_mesh + compute, cold
   double repeat_ms = 0;      // update_positions + compute, median of repeats
+  double repeat_cpu_ms = 0;  // process CPU time (all threads) of the median warm call
   std::vector<StageTiming> stages;  // of the last call
   double rays_per_second = 0;  // ray backends: valid points * rays / trace time
   std::size_t device_bytes = 0;
@@ -48,7 +50,7 @@ struct MeshResult {
   std::string name;
   std::size_t vertices = 0, faces = 0;
   std::vector<BackendRun> runs;
-  std::optional<double> cgal_seconds, meshlab_seconds, smooth_ms;
+  std::optional<double> cgal_seconds, cgal_cpu_seconds, meshlab_seconds, smooth_ms;
   std::string cgal_error, meshlab_error;
 };
 

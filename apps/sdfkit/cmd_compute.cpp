@@ -24,6 +24,8 @@ void add_sdf_options(CLI::App& cmd, SdfCliOptions& o) {
   cmd.add_option("--resolution", o.backend_config.resolution, "Framebuffer size in pixels (Vulkan)")
       ->check(CLI::Range(16, 8192));
   cmd.add_option("--memory-cap", o.backend_config.memory_cap, "Device memory cap in bytes (OpenCL)");
+  cmd.add_option("--accel", o.backend_config.accel, "OpenCL acceleration structure: bvh (default) | octree")
+      ->check(CLI::IsMember({"bvh", "octree"}));
   cmd.add_flag("--profile", o.backend_config.profile, "Time each pass on the device");
   cmd.add_option("--smooth", o.smooth, "k-ring Gaussian smoothing of the result (rings, 0 = off)")
       ->check(CLI::Range(0, 64));

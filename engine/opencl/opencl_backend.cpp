@@ -3,7 +3,6 @@
 #include "cl_api.hpp"
 
 #include "sdfkit/core/error.hpp"
-#include "sdfkit/core/log.hpp"
 
 #include <glm/vec4.hpp>
 
@@ -11,6 +10,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -116,17 +116,19 @@ struct OpenClBackend::Impl {
   detail::Context context;
   detail::Queue queue;
   detail::Program program;
-  detail::Kernel k_cone, k_trace, k_gather, k_dirs;
+  detail::Kernel k_cone, k_trace, k_packets, k_gather, k_dirs;
+  bool packets = false;  // BVH traced by trace_packets
 
   // Geometry (resident between computes).
   Mesh mesh;
   bool has_mesh = false;
   Octree octree;
-  detail::Buffer nodes, cells, refs, faces;
+  Bvh bvh;
+  detail::Buffer nodes, cells, tris;
   std::size_t geometry_bytes = 0;
 
   // The cone table of the last (rays, cone) and the per-batch buffers.
-  detail::Buffer table;
+  detail::Buffer table, ray_order;
   int table_rays = 0;
   float table_cone = 0.0f;
   detail::Buffer points, normals, keys, values, kept;
@@ -170,6 +172,8 @@ void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
   build_program();
   k_cone = make_kernel("make_cone");
   k_trace = make_kernel("trace_rays");
+  packets = cfg.accel == Accel::Bvh && cfg.bvh_packets.value_or(info.type == "CPU");
+  if (packets) k_packets = make_kernel("trace_packets");
   k_gather = make_kernel("gather_points");
   k_dirs = make_kernel("ray_directions");
 }
@@ -182,6 +186,7 @@ void OpenClBackend::Impl::build_program() {
   // A node pops one entry and pushes at most 8 children: 7 per level plus the root.
   const int stack = 7 * std::max(config.octree_max_depth, 1) + 2;
   std::string options = "-cl-std=CL1.2 -DSTACK_SIZE=" + std::to_string(stack);
+  if (config.accel == Accel::Bvh) options += " -DSDFKIT_BVH=1";
   cl_device_fp_config fp = 0;
   check(clGetDeviceInfo(device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, nullptr),
         "querying the device's float support");
@@ -227,32 +232,47 @@ void OpenClBackend::Impl::run(cl_kernel kernel, std::size_t items, std::size_t l
 // only grow, so moving vertices reuses the allocations.
 void OpenClBackend::Impl::rebuild_geometry() {
   auto start = std::chrono::steady_clock::now();
-  octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
+  // The triangle list of the leaves, leaf by leaf (octree: a triangle once per leaf it touches).
+  const std::vector<std::uint32_t>* order = nullptr;
+  if (config.accel == Accel::Bvh) {
+    bvh = build_bvh(mesh, BvhParams{config.bvh_leaf_size});
+    order = &bvh.order;
+  } else {
+    octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
+    order = &octree.refs;
+  }
+  // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w.
   const std::vector<glm::vec3> normals_f = face_normals(mesh);
-  std::vector<glm::vec4> face_data(3 * mesh.triangles.size());
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+  std::vector<glm::vec4> records(3 * order->size());
+  for (std::size_t k = 0; k < order->size(); ++k) {
+    const std::uint32_t f = (*order)[k];
     const auto& t = mesh.triangles[f];
     const glm::vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
-    face_data[3 * f] = glm::vec4(a, normals_f[f].x);
-    face_data[3 * f + 1] = glm::vec4(b - a, normals_f[f].y);
-    face_data[3 * f + 2] = glm::vec4(c - a, normals_f[f].z);
+    records[3 * k] = glm::vec4(a, normals_f[f].x);
+    records[3 * k + 1] = glm::vec4(b - a, normals_f[f].y);
+    records[3 * k + 2] = glm::vec4(c - a, normals_f[f].z);
   }
   octree_ms = ms_since(start);
 
   start = std::chrono::steady_clock::now();
   const auto bytes_of = [](const auto& v) { return v.size() * sizeof(v[0]); };
   const cl_context ctx = context.get();
-  nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
-  cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
-  refs.reserve(ctx, bytes_of(octree.refs), CL_MEM_READ_ONLY, "octree triangle lists");
-  faces.reserve(ctx, bytes_of(face_data), CL_MEM_READ_ONLY, "triangles");
-  write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
-  write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
-  write(refs.get(), bytes_of(octree.refs), octree.refs.data(), "octree triangle lists");
-  write(faces.get(), bytes_of(face_data), face_data.data(), "triangles");
+  if (config.accel == Accel::Bvh) {
+    // The BVH's nodes travel in `cells` (float4 pairs); `nodes` is a placeholder argument.
+    cells.reserve(ctx, bytes_of(bvh.nodes), CL_MEM_READ_ONLY, "BVH nodes");
+    nodes.reserve(ctx, 16, CL_MEM_READ_ONLY, "unused octree nodes");
+    write(cells.get(), bytes_of(bvh.nodes), bvh.nodes.data(), "BVH nodes");
+  } else {
+    nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
+    cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
+    write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
+    write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
+  }
+  tris.reserve(ctx, bytes_of(records), CL_MEM_READ_ONLY, "triangles");
+  write(tris.get(), bytes_of(records), records.data(), "triangles");
   finish("uploading the mesh");
   upload_ms = ms_since(start);
-  geometry_bytes = nodes.size() + cells.size() + refs.size() + faces.size();
+  geometry_bytes = nodes.size() + cells.size() + tris.size();
 }
 
 void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
@@ -268,6 +288,20 @@ void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
   const cl_mem t = table.get();
   set_args(k_cone.get(), "make_cone", cl_int{rays}, one_minus_cos, f_hi, f_lo, t);
   run(k_cone.get(), static_cast<std::size_t>(rays), 0, "make_cone");
+  // Packet order: the rays sorted by azimuth (phi_i = i * golden angle), so each packet of
+  // consecutive slots is a wedge of the cone whose rays meet nearby triangles. Only the order
+  // in which rays are traced changes; every ray keeps its index and weight.
+  std::vector<cl_uint> order(static_cast<std::size_t>(rays));
+  std::vector<double> phi(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = static_cast<cl_uint>(i);
+    phi[i] = std::fmod(static_cast<double>(i) * kGoldenAngle, 2.0 * M_PI);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](cl_uint a, cl_uint b) { return phi[a] < phi[b]; });
+  ray_order.reserve(context.get(), order.size() * sizeof(cl_uint), CL_MEM_READ_ONLY, "the ray order");
+  check(clEnqueueWriteBuffer(queue.get(), ray_order.get(), CL_TRUE, 0, order.size() * sizeof(cl_uint),
+                             order.data(), 0, nullptr, nullptr),
+        "uploading the ray order");
   table_rays = rays;
   table_cone = cone_degrees;
 }
@@ -284,6 +318,7 @@ std::string OpenClBackend::device_name() const {
 
 const DeviceInfo& OpenClBackend::device() const { return impl_->info; }
 const Octree& OpenClBackend::octree() const { return impl_->octree; }
+const Bvh& OpenClBackend::bvh() const { return impl_->bvh; }
 
 void OpenClBackend::set_mesh(const Mesh& mesh) {
   validate_mesh(mesh, "the mesh given to the OpenCL backend");
@@ -359,10 +394,20 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
     const auto count32 = static_cast<cl_uint>(count);
     m.write(m.points.get(), count * sizeof(cl_float4), &pts[first], "query points");
     m.write(m.normals.get(), count * sizeof(cl_float4), &nrm[first], "query normals");
-    set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.refs.get(),
-             m.faces.get(), m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
-             query.origin_offset, rule, m.keys.get());
-    m.run(m.k_trace.get(), count * nr, m.config.work_group_size, "trace_rays");
+    if (m.packets) {
+      // Packets of kPacket rays of one point per work item (cl/sdf_trace.cl).
+      constexpr std::size_t kPacket = 8;
+      set_args(m.k_packets.get(), "trace_packets", m.cells.get(), m.tris.get(), m.points.get(),
+               m.normals.get(), m.table.get(), m.ray_order.get(), cl_int{rays}, count32, query.origin_offset, rule,
+               m.keys.get());
+      m.run(m.k_packets.get(), count * ((nr + kPacket - 1) / kPacket), m.config.work_group_size,
+            "trace_packets");
+    } else {
+      set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.tris.get(),
+               m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
+               query.origin_offset, rule, m.keys.get());
+      m.run(m.k_trace.get(), count * nr, m.config.work_group_size, "trace_rays");
+    }
     set_args(m.k_gather.get(), "gather_points", m.keys.get(), cl_int{rays}, count32,
              m.table.get(), m.values.get(), m.kept.get());
     m.run(m.k_gather.get(), count, 0, "gather_points");
@@ -382,7 +427,7 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
 }
 
 std::vector<StageTiming> OpenClBackend::last_timings() const {
-  return {{"octree_build", impl_->octree_ms},
+  return {{impl_->config.accel == Accel::Bvh ? "bvh_build" : "octree_build", impl_->octree_ms},
           {"upload", impl_->upload_ms},
           {"trace_gather", impl_->trace_ms}};
 }

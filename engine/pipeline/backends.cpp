@@ -64,6 +64,12 @@ std::unique_ptr<SdfBackend> make_opencl([[maybe_unused]] const BackendConfig& c)
   cl::OpenClConfig config;
   config.device = c.device;
   if (c.memory_cap > 0) config.memory_cap = c.memory_cap;
+  if (c.accel == "octree")
+    config.accel = cl::Accel::Octree;
+  else if (c.accel.empty() || c.accel == "bvh")
+    config.accel = cl::Accel::Bvh;
+  else
+    throw InputError("--accel must be bvh or octree, got '" + c.accel + "'");
   return std::make_unique<cl::OpenClBackend>(config);
 #else
   throw DeviceError("this sdfkit was built without the OpenCL backend (SDFKIT_WITH_OPENCL=OFF)");

@@ -11,12 +11,27 @@ bool no_device_allowed() {
   return v != nullptr && std::string(v) == "1";
 }
 
-cl::OpenClBackend* opencl_backend() {
-  static std::unique_ptr<cl::OpenClBackend> backend = [] {
-    if (cl::list_devices().empty()) return std::unique_ptr<cl::OpenClBackend>();
-    return std::make_unique<cl::OpenClBackend>();
-  }();
-  return backend.get();
+const char* tracer_name(Tracer t) {
+  switch (t) {
+    case Tracer::BvhPackets: return "BvhPackets";
+    case Tracer::BvhSingle: return "BvhSingle";
+    case Tracer::Octree: return "Octree";
+  }
+  return "?";
+}
+
+cl::OpenClBackend* opencl_backend(Tracer tracer) {
+  static const bool has_device = !cl::list_devices().empty();
+  static std::unique_ptr<cl::OpenClBackend> backends[3];
+  if (!has_device) return nullptr;
+  auto& b = backends[static_cast<int>(tracer)];
+  if (!b) {
+    cl::OpenClConfig config;
+    config.accel = tracer == Tracer::Octree ? cl::Accel::Octree : cl::Accel::Bvh;
+    config.bvh_packets = tracer == Tracer::BvhPackets;
+    b = std::make_unique<cl::OpenClBackend>(config);
+  }
+  return b.get();
 }
 
 }  // namespace sdfkit::test

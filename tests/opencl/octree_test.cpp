@@ -2,7 +2,10 @@
 // triangle that touches a leaf's cell is referenced from it).
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
+#include "sdfkit/opencl/bvh.hpp"
 #include "sdfkit/opencl/octree.hpp"
+
+#include <glm/vector_relational.hpp>
 
 #include <gtest/gtest.h>
 
@@ -119,4 +122,46 @@ TEST(Octree, RejectsBadParameters) {
   EXPECT_THROW(build_octree(mesh, {0, 8}), InputError);
   EXPECT_THROW(build_octree(mesh, {17, 8}), InputError);
   EXPECT_THROW(build_octree(mesh, {8, 0}), InputError);
+}
+
+// The BVH: every non-degenerate triangle in exactly one leaf, boxes nest and contain their
+// triangles, depth within the device stack.
+TEST(Bvh, LeavesPartitionTheTrianglesAndBoxesNest) {
+  using sdfkit::cl::Bvh;
+  using sdfkit::cl::BvhNode;
+  Mesh mesh = shapes::torus(2.0f, 0.6f, 48, 24);
+  mesh.triangles.push_back({0, 0, 1});  // degenerate
+  const Bvh b = sdfkit::cl::build_bvh(mesh, {4});
+  const auto degenerate = degenerate_faces(mesh);
+  std::vector<int> seen(mesh.triangles.size(), 0);
+  std::vector<std::pair<std::uint32_t, int>> todo{{0, 0}};
+  std::size_t leaves = 0;
+  int depth = 0;
+  auto inside = [](const BvhNode& outer, glm::vec3 p) {
+    return glm::all(glm::lessThanEqual(outer.min, p)) && glm::all(glm::lessThanEqual(p, outer.max));
+  };
+  while (!todo.empty()) {
+    const auto [i, d] = todo.back();
+    todo.pop_back();
+    depth = std::max(depth, d);
+    const BvhNode& n = b.nodes[i];
+    if (n.is_leaf()) {
+      ++leaves;
+      for (std::uint32_t k = n.first_or_second; k < n.first_or_second + n.triangles(); ++k) {
+        const std::uint32_t f = b.order[k];
+        ++seen[f];
+        for (std::uint32_t v : mesh.triangles[f]) EXPECT_TRUE(inside(n, mesh.positions[v]));
+      }
+      continue;
+    }
+    for (std::uint32_t c : {i + 1, n.first_or_second}) {
+      ASSERT_LT(c, b.nodes.size());
+      EXPECT_TRUE(inside(n, b.nodes[c].min) && inside(n, b.nodes[c].max));
+      todo.push_back({c, d + 1});
+    }
+  }
+  EXPECT_EQ(leaves, b.leaf_count);
+  EXPECT_EQ(depth, b.depth);
+  EXPECT_LT(depth, 72);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) EXPECT_EQ(seen[f], degenerate[f] ? 0 : 1) << f;
 }

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 using namespace sdfkit;
 
@@ -30,11 +31,12 @@ Pair run_both(cl::OpenClBackend& backend, const Mesh& mesh, const SdfOptions& o)
 
 }  // namespace
 
-class OpenClVsEmbree : public ::testing::TestWithParam<const char*> {};
+class OpenClVsEmbree : public ::testing::TestWithParam<std::tuple<const char*, test::Tracer>> {};
 
 TEST_P(OpenClVsEmbree, ValuesAgreePerVertexAndPerFace) {
-  SDFKIT_REQUIRE_CL(backend);
-  const Mesh mesh = io::load_asset(test::data_mesh(GetParam())).mesh;
+  const char* name = std::get<0>(GetParam());
+  SDFKIT_REQUIRE_CL_ACCEL(backend, std::get<1>(GetParam()));
+  const Mesh mesh = io::load_asset(test::data_mesh(name)).mesh;
   for (SdfDomain domain : {SdfDomain::Vertex, SdfDomain::Face}) {
     for (FalseHitRule rule : {FalseHitRule::Paper, FalseHitRule::Cgal}) {
       SdfOptions o;
@@ -45,12 +47,12 @@ TEST_P(OpenClVsEmbree, ValuesAgreePerVertexAndPerFace) {
       const SdfField b = finish_field(mesh, domain, p.embree);
       const double med = test::median_relative_difference(a.values, b.values);
       const double r = test::pearson(a.values, b.values);
-      EXPECT_LE(med, 0.01) << GetParam() << " domain " << int(domain) << " rule " << int(rule);
-      EXPECT_GE(r, 0.99) << GetParam() << " domain " << int(domain) << " rule " << int(rule);
+      EXPECT_LE(med, 0.01) << name << " domain " << int(domain) << " rule " << int(rule);
+      EXPECT_GE(r, 0.99) << name << " domain " << int(domain) << " rule " << int(rule);
       // Same rays, same hits: nearly every point keeps the same number of rays.
       std::size_t same_kept = 0;
       for (std::size_t i = 0; i < a.values.size(); ++i) same_kept += p.opencl.kept_rays[i] == p.embree.kept_rays[i];
-      EXPECT_GE(same_kept, a.values.size() * 95 / 100) << GetParam();
+      EXPECT_GE(same_kept, a.values.size() * 95 / 100) << name;
     }
   }
 }
@@ -62,8 +64,18 @@ auto param_name = [](const auto& param_info) {
   return s;
 };
 
-INSTANTIATE_TEST_SUITE_P(CgalMeshes, OpenClVsEmbree, ::testing::Values("elephant.off", "cow.off"),
-                         param_name);
+INSTANTIATE_TEST_SUITE_P(CgalMeshes, OpenClVsEmbree,
+                         ::testing::Values(std::tuple{"elephant.off", test::Tracer::BvhPackets},
+                                           std::tuple{"cow.off", test::Tracer::BvhPackets},
+                                           std::tuple{"elephant.off", test::Tracer::BvhSingle},
+                                           std::tuple{"elephant.off", test::Tracer::Octree}),
+                         [](const auto& p) {
+                           std::string s = std::string(std::get<0>(p.param)) + "_" +
+                                           test::tracer_name(std::get<1>(p.param));
+                           for (char& c : s)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return s;
+                         });
 
 // Tiny awkward meshes (an open cube; degenerate sliding triangles): too few points for
 // statistics, so point by point. Rays of a cube's corner run exactly along edges and through

@@ -10,6 +10,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
 
 using namespace sdfkit;
 
@@ -125,8 +128,10 @@ TEST(OpenClRobustness, NoHitsAtAllAreFilled) {
   }
 }
 
-TEST(OpenClRobustness, UpdatePositionsEqualsFreshSetMesh) {
-  SDFKIT_REQUIRE_CL(backend);
+class OpenClUpdate : public ::testing::TestWithParam<test::Tracer> {};
+
+TEST_P(OpenClUpdate, UpdatePositionsEqualsFreshSetMesh) {
+  SDFKIT_REQUIRE_CL_ACCEL(backend, GetParam());
   const Mesh before = shapes::capsule(1.0f, 3.0f, 40, 20);
   Mesh after = before;
   for (glm::vec3& p : after.positions)
@@ -142,6 +147,9 @@ TEST(OpenClRobustness, UpdatePositionsEqualsFreshSetMesh) {
   EXPECT_EQ(moved.kept_rays, fresh.kept_rays);
   EXPECT_THROW(backend.update_positions(std::vector<glm::vec3>(3)), Error);
 }
+
+INSTANTIATE_TEST_SUITE_P(Tracer, OpenClUpdate, ::testing::Values(test::Tracer::BvhPackets, test::Tracer::BvhSingle, test::Tracer::Octree),
+                         [](const auto& p) { return std::string(test::tracer_name(p.param)); });
 
 TEST(OpenClRobustness, SmallMemoryCapBatchesWithoutChangingResults) {
   SDFKIT_REQUIRE_CL(shared);
@@ -181,4 +189,25 @@ TEST(OpenClRobustness, DeviceSelectionByIndexNameAndUnknown) {
   }
   unknown.device = std::to_string(devices.size());
   EXPECT_THROW(cl::OpenClBackend{unknown}, DeviceError);
+}
+
+// Without any OpenCL platform (the ICD loader pointed at an empty vendor directory, in a child
+// process so this process's loader stays as it is): list_devices() is empty and the backend
+// refuses with the sentence naming the packages to install.
+TEST(OpenClRobustness, NoPlatformGivesTheInstallSentence) {
+  if (const char* child = std::getenv("SDFKIT_TEST_NO_PLATFORM_CHILD"); child && std::string(child) == "1") {
+    EXPECT_TRUE(cl::list_devices().empty());
+    try {
+      cl::OpenClBackend b;
+      ADD_FAILURE() << "a backend was created without a platform";
+    } catch (const DeviceError& e) {
+      EXPECT_NE(std::string(e.what()).find("pocl-opencl-icd"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("no OpenCL platform found"), std::string::npos) << e.what();
+    }
+    return;
+  }
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  const std::string cmd = "SDFKIT_TEST_NO_PLATFORM_CHILD=1 OCL_ICD_VENDORS=/nonexistent-sdfkit-vendors '" +
+                          self + "' --gtest_filter=OpenClRobustness.NoPlatformGivesTheInstallSentence >/dev/null 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
 }

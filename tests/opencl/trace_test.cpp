@@ -74,8 +74,10 @@ void expect_closest_hits(cl::OpenClBackend& backend, const Mesh& mesh) {
 
 }  // namespace
 
-TEST(OpenClTrace, ClosestHitEqualsBruteForceOnARotatedTorus) {
-  SDFKIT_REQUIRE_CL(backend);
+class OpenClTrace : public ::testing::TestWithParam<test::Tracer> {};
+
+TEST_P(OpenClTrace, ClosestHitEqualsBruteForceOnARotatedTorus) {
+  SDFKIT_REQUIRE_CL_ACCEL(backend, GetParam());
   const Mesh mesh = shapes::torus(2.0f, 0.7f, 40, 20);
   const glm::vec3 k = glm::normalize(glm::vec3(-2, 1, 4));
   const float c = std::cos(1.1f), s = std::sin(1.1f), t = 1 - c;
@@ -86,10 +88,13 @@ TEST(OpenClTrace, ClosestHitEqualsBruteForceOnARotatedTorus) {
   expect_closest_hits(backend, transformed(mesh, m));
 }
 
-TEST(OpenClTrace, ClosestHitEqualsBruteForceOnCellPlanes) {
-  SDFKIT_REQUIRE_CL(backend);
+TEST_P(OpenClTrace, ClosestHitEqualsBruteForceOnCellPlanes) {
+  SDFKIT_REQUIRE_CL_ACCEL(backend, GetParam());
   // An axis-aligned box centred at the origin: faces, vertices and rays lie on the octree's
   // mid planes and directions have exact zero components.
   expect_closest_hits(backend, shapes::box(2.0f, 2.0f, 2.0f, 6));
   expect_closest_hits(backend, shapes::icosphere(1.0f, 3));
 }
+
+INSTANTIATE_TEST_SUITE_P(Tracer, OpenClTrace, ::testing::Values(test::Tracer::BvhPackets, test::Tracer::BvhSingle, test::Tracer::Octree),
+                         [](const auto& p) { return std::string(test::tracer_name(p.param)); });

@@ -26,6 +26,7 @@ struct BackendConfig {
   bool profile = false;
   // OpenCL ray casting
   std::size_t memory_cap = 0;            // bytes; 0 = the backend's default
+  std::string accel;                     // "bvh" (default) or "octree"
 };
 
 // Creates a backend session. Throws DeviceError when the requested backend is not built in or

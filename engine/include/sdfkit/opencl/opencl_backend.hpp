@@ -3,21 +3,29 @@
 // triangles built on the host, rays generated, traced and gathered on the device, one float and
 // one kept-ray count per point read back.
 //
+// Acceleration structure (OpenClConfig::accel): a BVH (binned SAH, the default: on PoCL it
+// needs far fewer triangle tests per ray than the octree) or the paper's octree (front-to-back
+// traversal in the style of Laine & Karras). Both are rebuilt on the host by update_positions.
+//
 // A backend object is a session: it holds the OpenCL context, the compiled program, its kernels
 // and the uploaded geometry, so a caller that moves vertices (update_positions) and computes
-// again pays only the octree rebuild, the re-upload and the tracing.
+// again pays only the rebuild of the acceleration structure, the re-upload and the tracing.
+// A session is not thread-safe: use one per thread.
 //
-// Device memory: the geometry (per face 64 bytes + the octree) stays resident; the per-point
+// Device memory: the geometry (48 bytes per leaf reference of a triangle + 24 bytes per octree
+// node) stays resident; the per-point
 // buffers (inputs, one 8-byte key per ray, outputs) are sized to fit OpenClConfig::memory_cap,
 // and the points are processed in as many batches as that takes.
 
 #include "sdfkit/core/sdf.hpp"
+#include "sdfkit/opencl/bvh.hpp"
 #include "sdfkit/opencl/octree.hpp"
 
 #include <glm/vec4.hpp>
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -35,6 +43,8 @@ struct DeviceInfo {
 // a missing ICD); throws DeviceError for other driver failures.
 std::vector<DeviceInfo> list_devices();
 
+enum class Accel { Bvh, Octree };
+
 struct OpenClConfig {
   // "" = the environment variable SDFKIT_CL_DEVICE, or when that is unset or empty the first
   // GPU, else the first device of any kind. Otherwise an index into list_devices() ("0") or a
@@ -42,9 +52,16 @@ struct OpenClConfig {
   std::string device;
   // Bytes of device memory for the per-batch point buffers (not the geometry).
   std::size_t memory_cap = std::size_t{512} << 20;
+  Accel accel = Accel::Bvh;
   // Octree: deepest level (root = 0) and the triangle count under which a node stays a leaf.
   int octree_max_depth = 10;
   int octree_leaf_size = 8;
+  // BVH: the triangle count under which the SAH may stop splitting.
+  int bvh_leaf_size = 4;
+  // BVH: trace 8 rays of a point together as one vector packet per work item (SIMD on CPU
+  // devices) instead of one ray per work item. Unset: packets on CPU devices, single rays on
+  // GPUs (whose work items are scalar lanes already).
+  std::optional<bool> bvh_packets;
   // Work-group size of the trace kernel; 0 lets the driver choose.
   std::size_t work_group_size = 0;
 };
@@ -62,14 +79,16 @@ public:
   void set_mesh(const Mesh& mesh) override;
   void update_positions(std::span<const glm::vec3> positions) override;
   RawSdf compute(const SdfQuery& query, const SdfOptions& options) override;
-  // "octree_build" and "upload" of the last set_mesh/update_positions, "trace_gather" of the
-  // last compute (milliseconds, wall clock, including the queue's completion).
+  // "octree_build" (or "bvh_build") and "upload" of the last set_mesh/update_positions,
+  // "trace_gather" of the last compute (milliseconds, wall clock, including the queue's
+  // completion).
   std::vector<StageTiming> last_timings() const override;
   // Geometry + octree + the per-batch buffers of the last compute, in bytes.
   std::size_t device_memory_bytes() const override;
 
   const DeviceInfo& device() const;
-  const Octree& octree() const;
+  const Octree& octree() const;  // empty unless accel == Octree
+  const Bvh& bvh() const;        // empty unless accel == Bvh
   // Points per batch the memory cap allows for `rays` rays per point.
   std::size_t batch_points(int rays) const;
 
