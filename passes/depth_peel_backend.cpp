@@ -158,7 +158,10 @@ DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
                      std::to_string(ctx->capabilities().max_image_dimension_2d) + ", got " +
                      std::to_string(cfg.resolution));
   if (cfg.max_layers < 1) throw InputError("max_layers must be at least 1");
-  batch = cfg.cameras_per_batch > 0 ? cfg.cameras_per_batch : 8;
+  // One camera per batch by default: on lavapipe, layered rendering of 8 cameras (16 layers) was
+  // 5.7x slower per camera than one camera (2 layers) at 512^2 (elephant, 32 views: 6.1 s vs
+  // 1.08 s of peel GPU time), the tiles of many layers no longer fitting in the CPU caches.
+  batch = cfg.cameras_per_batch > 0 ? cfg.cameras_per_batch : 1;
   batch = std::min({batch, cfg.views, static_cast<int>(ctx->capabilities().max_framebuffer_layers / 2)});
   layers_per_submit = cfg.layers_per_submit > 0 ? cfg.layers_per_submit : 3;
   cameras = make_cameras(cfg.views);

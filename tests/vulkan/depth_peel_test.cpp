@@ -6,6 +6,7 @@
 #include "analytic.hpp"
 #include "compare.hpp"
 
+#include "sdfkit/core/log.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/vulkan/depth_peel.hpp"
 
@@ -113,6 +114,53 @@ TEST(DepthPeel, AnalyticShapesMatchTheIdealEstimator) {
     EXPECT_LT(test::quantile_relative_difference(a, b, 0.9), c.max_p90_rel) << c.name;
     EXPECT_LT(std::fabs(test::median_signed_relative_difference(a, b)), 0.01) << c.name;  // no bias
   }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+// A session reused on moved vertices: scaling the capsule by 2 scales the framing with it, so
+// every image is the same up to rounding and every value doubles.
+TEST(DepthPeel, UpdatePositionsReusesTheSessionAndScalesValues) {
+  auto be = make_backend(small_config(32, 128));
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  const Mesh m = shapes::capsule(1.0f, 4.0f, 32, 16);
+  Mesh big = m;
+  for (auto& p : big.positions) p *= 2.0f;
+  SdfOptions o;
+  be->set_mesh(m);
+  const SdfField a = compute_sdf(*be, m, o);
+  be->update_positions(big.positions);
+  const SdfField b = compute_sdf(*be, big, o);
+  be->update_positions(m.positions);
+  const SdfField c = compute_sdf(*be, m, o);
+  ASSERT_EQ(a.values.size(), b.values.size());
+  for (std::size_t i = 0; i < a.values.size(); ++i) {
+    EXPECT_NEAR(b.values[i], 2.0f * a.values[i], 1e-3f * a.values[i]) << i;
+    EXPECT_EQ(c.values[i], a.values[i]) << i;  // deterministic
+  }
+  EXPECT_THROW(be->update_positions(std::vector<glm::vec3>(3)), Error);
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
+  DepthPeelConfig cfg = small_config(32, 128);
+  cfg.max_layers = 1;
+  auto be = make_backend(cfg);
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  // A torus has up to 4 layers along most views; with the cap at 1 only the outermost count.
+  const Mesh m = shapes::torus(3.0f, 1.0f, 48, 24);
+  be->set_mesh(m);
+  std::vector<std::string> warnings;
+  set_log_sink([&](LogLevel level, std::string_view msg) {
+    if (level == LogLevel::Warning) warnings.emplace_back(msg);
+  });
+  const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
+  set_log_sink(nullptr);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("max_layers = 1"), std::string::npos) << warnings[0];
+  EXPECT_EQ(be->last_layer_count(), 1);
+  std::size_t valued = 0;
+  for (auto k : r.kept_rays) valued += k > 0;
+  EXPECT_GT(valued, m.vertex_count() / 2);
   SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
 }
 
