@@ -45,13 +45,16 @@ namespace sdfkit::vk {
 struct DepthPeelConfig {
   std::string device;           // see ContextConfig::device
   int views = 256;              // cameras on the sphere
-  int resolution = 512;         // pixels per side of each camera's image
+  // Pixels per side of each camera's image. 256 by measurement: against Embree, 256^2 and 512^2
+  // gave the same median differences (elephant 3.96 / 4.02 %, cow 3.33 / 3.33 % at 64 views;
+  // the difference is view-sampling noise), while 512^2 cost ~35% more CPU on armadillo.
+  int resolution = 256;
   int max_layers = 64;          // peel iterations per camera at most
   bool validation = false;
   bool profile = false;         // per-pass GPU timestamps in last_timings()
   int max_samples_per_point = 0;  // 0 = automatic bound (see above)
-  int cameras_per_batch = 0;      // 0 = automatic (layered rendering of several cameras)
-  int layers_per_submit = 0;      // 0 = automatic (peel iterations recorded per submission)
+  int cameras_per_batch = 0;      // 0 = automatic (1: measured fastest on lavapipe)
+  int layers_per_submit = 0;      // 0 = adaptive (from the previous camera's layer count)
 };
 
 // Devices as `sdfkit devices` shows them, with suitability for this backend.
