@@ -139,7 +139,9 @@ struct DepthPeelBackend::Impl {
   void ensure_query_buffers(std::size_t n, std::uint32_t max_samples);
   void write_sets();
   std::uint32_t auto_max_samples(float cone_degrees) const;
-  RawSdf run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu);
+  // Gather pass; with upload_* (host-visible), copies them into counts/samples first.
+  RawSdf run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu,
+                    const Buffer* upload_counts = nullptr, const Buffer* upload_samples = nullptr);
 };
 
 DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
@@ -266,8 +268,8 @@ void DepthPeelBackend::Impl::ensure_query_buffers(std::size_t n, std::uint32_t m
   if (point_capacity < cap) {
     points = create_buffer(*ctx, 2 * cap * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
     counts = create_buffer(*ctx, cap * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                           MemoryUse::Upload);
-    result = create_buffer(*ctx, cap * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Readback);
+                           MemoryUse::DeviceLocal);
+    result = create_buffer(*ctx, cap * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Readback);
     point_capacity = cap;
     changed = true;
   }
@@ -278,7 +280,8 @@ void DepthPeelBackend::Impl::ensure_query_buffers(std::size_t n, std::uint32_t m
       throw DeviceError("the per-point sample storage (" + std::to_string(bytes >> 20) +
                         " MiB) exceeds the device's storage buffer range; use fewer views or a smaller "
                         "max_samples_per_point");
-    samples = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
+    samples = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                            MemoryUse::DeviceLocal);
     sample_capacity = sc;
     changed = true;
   }
@@ -316,11 +319,28 @@ void DepthPeelBackend::Impl::write_sets() {
   }
 }
 
-RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu) {
+RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu,
+                                          const Buffer* upload_counts, const Buffer* upload_samples) {
   RenderGraph g;
   auto cnt = g.import_buffer("counts", counts.size, {counts.get()});
   auto smp = g.import_buffer("samples", samples.size, {samples.get()});
   auto res = g.import_buffer("result", result.size, {result.get()});
+  if (upload_counts && upload_samples) {
+    // Test entry: the host's samples replace what the diameter passes would have stored.
+    auto sc = g.import_buffer("staged_counts", upload_counts->size, {upload_counts->get()});
+    auto ss = g.import_buffer("staged_samples", upload_samples->size, {upload_samples->get()});
+    auto up = g.add_pass("upload_samples", PassKind::Transfer);
+    up.transfer_src(sc);
+    up.transfer_src(ss);
+    cnt = up.transfer_dst(cnt);
+    smp = up.transfer_dst(smp);
+    up.execute([&, sc, ss, cnt, smp](PassContext& pc) {
+      const VkBufferCopy c1{0, 0, upload_counts->size};
+      const VkBufferCopy c2{0, 0, upload_samples->size};
+      vkCmdCopyBuffer(pc.cmd, pc.buffer(sc), pc.buffer(cnt), 1, &c1);
+      vkCmdCopyBuffer(pc.cmd, pc.buffer(ss), pc.buffer(smp), 1, &c2);
+    });
+  }
   auto p = g.add_pass("gather", PassKind::Compute);
   p.storage_read(cnt);
   smp = p.storage_read_write(smp);
@@ -339,8 +359,8 @@ RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_sampl
   out.kept_rays.resize(n);
   const auto* r = static_cast<const std::uint32_t*>(result.mapped());
   for (std::size_t i = 0; i < n; ++i) {
-    std::memcpy(&out.values[i], &r[2 * i], 4);
-    out.kept_rays[i] = r[2 * i + 1];
+    std::memcpy(&out.values[i], &r[4 * i], 4);
+    out.kept_rays[i] = r[4 * i + 1];
   }
   return out;
 }
@@ -399,7 +419,6 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
       p[i] = glm::vec4(query.origins[i] - query.origin_offset * nrm, valid ? 1.0f : 0.0f);
       p[n + i] = glm::vec4(-nrm, 0.0f);
     }
-    std::memset(m.counts.mapped(), 0, n * 4);
   }
   m.timings.push_back({"upload", ms_since(t0)});
 
@@ -440,6 +459,11 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
       auto idx = g.import_buffer("indices", m.index_buffer.size, {m.index_buffer.get()});
       auto smp = g.import_buffer("samples", m.samples.size, {m.samples.get()});
 
+      if (base == 0 && layer == 1) {
+        auto clear = g.add_pass("clear_counts", PassKind::Transfer);
+        cnt = clear.transfer_dst(cnt);
+        clear.execute([&, cnt](PassContext& pc) { vkCmdFillBuffer(pc.cmd, pc.buffer(cnt), 0, VK_WHOLE_SIZE, 0); });
+      }
       auto reset = g.add_pass("reset_queries", PassKind::Transfer);
       reset.side_effect();
       reset.execute([&, steps](PassContext& pc) {
@@ -525,9 +549,9 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   RawSdf out = m.run_gather(n, max_samples, &gpu);
   m.timings.push_back({"gather", ms_since(t0)});
 
-  const auto* counts = static_cast<const std::uint32_t*>(m.counts.mapped());
+  const auto* accepted = static_cast<const std::uint32_t*>(m.result.mapped());
   std::size_t overflow = 0;
-  for (std::size_t i = 0; i < n; ++i) overflow += counts[i] > max_samples;
+  for (std::size_t i = 0; i < n; ++i) overflow += accepted[4 * i + 2] > max_samples;
   if (overflow > 0)
     log_warning(std::to_string(overflow) + " points had more than " + std::to_string(max_samples) +
                 " accepted views; the extra samples were dropped");
@@ -546,14 +570,17 @@ RawSdf DepthPeelBackend::gather_on_device(const std::vector<std::vector<std::pai
   std::uint32_t max_samples = 1;
   for (const auto& s : samples) max_samples = std::max<std::uint32_t>(max_samples, static_cast<std::uint32_t>(s.size()));
   m.ensure_query_buffers(n, max_samples);
-  auto* cnt = static_cast<std::uint32_t*>(m.counts.mapped());
-  auto* smp = static_cast<glm::vec2*>(m.samples.mapped());
+  Buffer staged_counts = create_buffer(*m.ctx, m.counts.size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::Upload);
+  Buffer staged_samples = create_buffer(*m.ctx, m.samples.size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUse::Upload);
+  std::memset(staged_counts.mapped(), 0, m.counts.size);
+  auto* cnt = static_cast<std::uint32_t*>(staged_counts.mapped());
+  auto* smp = static_cast<glm::vec2*>(staged_samples.mapped());
   for (std::size_t i = 0; i < n; ++i) {
     cnt[i] = static_cast<std::uint32_t>(samples[i].size());
     for (std::size_t j = 0; j < samples[i].size(); ++j)
       smp[i * max_samples + j] = glm::vec2(samples[i][j].first, samples[i][j].second);
   }
-  return m.run_gather(n, max_samples, nullptr);
+  return m.run_gather(n, max_samples, nullptr, &staged_counts, &staged_samples);
 }
 
 }  // namespace sdfkit::vk

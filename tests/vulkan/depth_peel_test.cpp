@@ -164,5 +164,29 @@ TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
   SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
 }
 
+// Past max_samples_per_point the extra samples are dropped with one warning; the first ones
+// stored still make a value.
+TEST(DepthPeel, SamplesPastTheBoundAreDroppedWithAWarning) {
+  DepthPeelConfig cfg = small_config(32, 128);
+  cfg.max_samples_per_point = 2;
+  auto be = make_backend(cfg);
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  const Mesh m = shapes::capsule(1.0f, 4.0f, 24, 12);
+  be->set_mesh(m);
+  std::vector<std::string> warnings;
+  set_log_sink([&](LogLevel level, std::string_view msg) {
+    if (level == LogLevel::Warning) warnings.emplace_back(msg);
+  });
+  const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
+  set_log_sink(nullptr);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("more than 2 accepted views"), std::string::npos) << warnings[0];
+  for (std::size_t i = 0; i < r.values.size(); ++i) {
+    EXPECT_LE(r.kept_rays[i], 2u);
+    EXPECT_TRUE(std::isfinite(r.values[i]));
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
 }  // namespace
 }  // namespace sdfkit::vk
