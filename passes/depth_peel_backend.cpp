@@ -5,6 +5,7 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/log.hpp"
+#include "sdfkit/core/topology.hpp"
 #include "sdfkit/vulkan/memory.hpp"
 #include "sdfkit/vulkan/pipeline.hpp"
 #include "sdfkit/vulkan/render_graph.hpp"
@@ -120,6 +121,7 @@ struct DepthPeelBackend::Impl {
   // Geometry.
   std::vector<Triangle> triangles;
   std::size_t vertex_count = 0;
+  bool front_layers = true;  // peel front layers for the current mesh
   std::vector<std::uint32_t> drawn;  // non-degenerate triangles, in index-buffer order
   Buffer position_buffer;            // V x vec3
   Buffer index_buffer;               // drawn x 3
@@ -372,6 +374,7 @@ std::string DepthPeelBackend::device_name() const { return impl_->ctx->info().na
 Context& DepthPeelBackend::context() { return *impl_->ctx; }
 const DepthPeelConfig& DepthPeelBackend::config() const { return impl_->cfg; }
 int DepthPeelBackend::last_layer_count() const { return impl_->last_layers; }
+bool DepthPeelBackend::peels_front_layers() const { return impl_->front_layers; }
 std::vector<StageTiming> DepthPeelBackend::last_timings() const { return impl_->timings; }
 std::size_t DepthPeelBackend::device_memory_bytes() const {
   return static_cast<std::size_t>(impl_->ctx->allocator().peak_bytes_in_use());
@@ -382,6 +385,9 @@ void DepthPeelBackend::set_mesh(const Mesh& mesh) {
   validate_mesh(mesh, "the mesh given to the Vulkan backend");
   impl_->triangles = mesh.triangles;
   impl_->vertex_count = mesh.positions.size();
+  const MeshReport report = analyze(mesh);
+  impl_->front_layers = impl_->cfg.front_layers == FrontLayers::Always || report.boundary_edges > 0 ||
+                      report.non_manifold_edges > 0;
   impl_->upload_geometry(mesh.positions);
   impl_->write_sets();
   impl_->timings = {{"upload_mesh", ms_since(t0)}};
@@ -491,11 +497,12 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
           vkCmdBeginQuery(pc.cmd, m.occlusion.get(), static_cast<std::uint32_t>(s), 0);
           PeelPush push = pp;
           for (const Pipeline* p : {&m.peel_front, &m.peel_back}) {
+            push.back = p == &m.peel_back ? 1u : 0u;
+            if (!push.back && !m.front_layers) continue;  // front layers stay empty (kNoSurface)
             vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p->get());
             vkCmdPushConstants(pc.cmd, p->layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                                0, sizeof(push), &push);
             vkCmdDrawIndexed(pc.cmd, index_count, count, 0, 0, 0);
-            push.back = 1;
           }
           vkCmdEndQuery(pc.cmd, m.occlusion.get(), static_cast<std::uint32_t>(s));
         });

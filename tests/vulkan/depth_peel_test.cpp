@@ -164,6 +164,32 @@ TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
   SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
 }
 
+// On a closed manifold mesh front layers cannot hold the closest hit, so Auto (back layers
+// only) and Always (the paper's alternation) give the same field.
+TEST(DepthPeel, FrontLayersDoNotChangeClosedMeshes) {
+  DepthPeelConfig cfg = small_config(32, 128);
+  auto auto_be = make_backend(cfg);
+  if (!auto_be) GTEST_SKIP() << "no Vulkan device";
+  cfg.front_layers = FrontLayers::Always;
+  auto always_be = make_backend(cfg);
+  const Mesh m = shapes::torus(3.0f, 1.0f, 48, 24);
+  auto_be->set_mesh(m);
+  always_be->set_mesh(m);
+  EXPECT_FALSE(auto_be->peels_front_layers());
+  EXPECT_TRUE(always_be->peels_front_layers());
+  for (FalseHitRule rule : {FalseHitRule::Paper, FalseHitRule::Cgal}) {
+    SdfOptions o;
+    o.false_hit = rule;
+    const SdfQuery q = make_query(m, o.domain);
+    const RawSdf a = auto_be->compute(q, o), b = always_be->compute(q, o);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.values.size(); ++i) differ += a.values[i] != b.values[i];
+    EXPECT_LE(differ, a.values.size() / 200);  // at most grazing-angle pixels differ
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(auto_be->context());
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(always_be->context());
+}
+
 // Past max_samples_per_point the extra samples are dropped with one warning; the first ones
 // stored still make a value.
 TEST(DepthPeel, SamplesPastTheBoundAreDroppedWithAWarning) {

@@ -25,7 +25,7 @@
 //  * The closest hit passes the false-intersection rule (Paper: hit normal . start normal <= 0;
 //    Cgal: view direction . hit normal > 0) or the ray is dropped.
 //  * Peeling stops when an occlusion query reports no fragment in the last layer (front and back
-//    layers are counted together), or at max_layers (a warning is logged when fragments were
+//    layers are counted together when front layers are peeled), or at max_layers (a warning is logged when fragments were
 //    still coming).
 //  * Each point stores at most max_samples_per_point (length, theta) pairs. The default bound
 //    exceeds the number of cameras that can fall inside one cone, so it is never reached; with a
@@ -42,6 +42,13 @@
 
 namespace sdfkit::vk {
 
+// Front layers matter only where a front face can be the closest hit behind a point: meshes
+// with boundary or non-manifold edges (or self-intersections). Auto peels them for meshes with
+// boundary or non-manifold edges and peels back layers alone otherwise (same result on closed
+// manifold meshes, about half the rasterization); Always alternates front and back layers for
+// every mesh as the paper does (use it for self-intersecting closed meshes).
+enum class FrontLayers { Auto, Always };
+
 struct DepthPeelConfig {
   std::string device;           // see ContextConfig::device
   int views = 256;              // cameras on the sphere
@@ -55,6 +62,7 @@ struct DepthPeelConfig {
   int max_samples_per_point = 0;  // 0 = automatic bound (see above)
   int cameras_per_batch = 0;      // 0 = automatic (1: measured fastest on lavapipe)
   int layers_per_submit = 0;      // 0 = adaptive (from the previous camera's layer count)
+  FrontLayers front_layers = FrontLayers::Auto;
 };
 
 // Devices as `sdfkit devices` shows them, with suitability for this backend.
@@ -79,8 +87,10 @@ public:
 
   Context& context();
   const DepthPeelConfig& config() const;
-  // Layers peeled in the last compute() (deepest batch) and whether the cap was hit.
+  // Layers peeled in the last compute() (deepest batch).
   int last_layer_count() const;
+  // Whether front layers are peeled for the current mesh (see FrontLayers).
+  bool peels_front_layers() const;
 
 private:
   struct Impl;
