@@ -407,7 +407,8 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   Impl& m = *impl_;
   validate_options(options);
   if (m.triangles.empty()) throw Error("compute() called before set_mesh()");
-  m.timings.clear();
+  // Keep the geometry upload of the preceding set_mesh/update_positions, replace the rest.
+  std::erase_if(m.timings, [](const StageTiming& t) { return t.stage != "upload_mesh"; });
   m.ctx->allocator().reset_peak();
   const std::size_t n = query.size();
   if (n == 0) return {};
@@ -524,6 +525,8 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
         });
       }
       const CompiledGraph plan = g.compile();
+      if (base == 0 && layer == 1 && log_level() <= LogLevel::Debug)
+        log_debug("depth peel render graph (first submission):\n" + plan.describe());
       auto t = execute(*m.ctx, plan, m.transients, {.profile = m.cfg.profile});
       gpu.insert(gpu.end(), t.begin(), t.end());
       // Only the images this graph used were moved to SHADER_READ_ONLY (their final layout).

@@ -2,11 +2,13 @@
 // and (when built with the Embree reference) compares its field with the reference.
 //
 //   sdfkit-vulkan-bench [--views N] [--resolution N] [--batch N] [--layers-per-submit N]
-//                       [--repeat N] [--profile] [--face] [--reference] mesh.off...
+//                       [--repeat N] [--profile] [--face] [--reference] [--print-graph]
+//                       [--validation] mesh.off...
 
 #include "vulkan_bench.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
 #include "sdfkit/io/asset.hpp"
 #ifdef SDFKIT_BENCH_HAS_REFERENCE
 #include "sdfkit/reference/embree_backend.hpp"
@@ -75,6 +77,7 @@ int main(int argc, char** argv) {
     else if (a == "--validation") cfg.validation = true;
     else if (a == "--face") options.domain = sdfkit::SdfDomain::Face;
     else if (a == "--reference") reference = true;
+    else if (a == "--print-graph") sdfkit::set_log_level(sdfkit::LogLevel::Debug);
     else files.push_back(a);
   }
   if (files.empty()) {
