@@ -53,6 +53,7 @@ struct DiameterPush {
   std::uint32_t rule;
   std::int32_t resolution;
   float front_tolerance;
+  std::uint32_t pending_slot;
 };
 struct GatherPush {
   std::uint32_t point_count;
@@ -85,7 +86,7 @@ const VkDescriptorType kPeelBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_
 const VkDescriptorType kDiameterBindings[] = {
     VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
 const VkDescriptorType kGatherBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
 
@@ -117,6 +118,7 @@ struct DepthPeelBackend::Impl {
   UniqueQueryPool occlusion;
   TransientPool transients;
   Buffer camera_buffer;
+  Buffer pending;  // per peel step of a submission: points not yet reached (host-read)
 
   // Geometry.
   std::vector<Triangle> triangles;
@@ -170,7 +172,7 @@ DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
   batch = cfg.cameras_per_batch > 0 ? cfg.cameras_per_batch : 1;
   batch = std::min({batch, cfg.views, static_cast<int>(ctx->capabilities().max_framebuffer_layers / 2)});
   // Layers recorded per submission: fixed when configured; by default the first submission of a
-  // camera covers one layer less than the previous camera needed, then one layer per submission,
+  // camera covers one pass less than the previous camera needed, then one layer per submission,
   // so that few passes beyond the last layer run (measured on armadillo, 32 views: 3 layers per
   // submission cost 7.0 s of CPU, 1 per submission 5.7 s).
   layers_per_submit = cfg.layers_per_submit > 0 ? cfg.layers_per_submit : 0;
@@ -214,6 +216,8 @@ DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
   camera_buffer = create_buffer(*ctx, cameras.size() * sizeof(GpuCamera), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                 MemoryUse::Upload);
+  pending = create_buffer(*ctx, 4 * static_cast<VkDeviceSize>(std::max(layers_per_submit, cfg.max_layers)),
+                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Readback);
   std::memcpy(camera_buffer.mapped(), cameras.data(), cameras.size() * sizeof(GpuCamera));
 
   VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, nullptr, 0, VK_QUERY_TYPE_OCCLUSION,
@@ -309,7 +313,8 @@ void DepthPeelBackend::Impl::write_sets() {
           {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, counts.get()},
           {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, samples.get()},
           {4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, ring[prev].view.get(), ro, sampler.get()},
-          {5, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, ring[i].view.get(), ro, sampler.get()}};
+          {5, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_NULL_HANDLE, ring[i].view.get(), ro, sampler.get()},
+          {6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pending.get()}};
       write_set(dev, diameter_sets[i], dw);
     }
   }
@@ -471,10 +476,13 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
         cnt = clear.transfer_dst(cnt);
         clear.execute([&, cnt](PassContext& pc) { vkCmdFillBuffer(pc.cmd, pc.buffer(cnt), 0, VK_WHOLE_SIZE, 0); });
       }
+      auto pend = g.import_buffer("pending", m.pending.size, {m.pending.get()});
       auto reset = g.add_pass("reset_queries", PassKind::Transfer);
       reset.side_effect();
-      reset.execute([&, steps](PassContext& pc) {
+      pend = reset.transfer_dst(pend);
+      reset.execute([&, steps, pend](PassContext& pc) {
         vkCmdResetQueryPool(pc.cmd, m.occlusion.get(), 0, static_cast<std::uint32_t>(steps));
+        vkCmdFillBuffer(pc.cmd, pc.buffer(pend), 0, VK_WHOLE_SIZE, 0);
       });
       for (int s = 0; s < steps; ++s) {
         const int k = layer + s;
@@ -512,10 +520,11 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
         diam.sampled(rings[cur]);
         cnt = diam.atomic(cnt);
         smp = diam.storage_write(smp);
+        pend = diam.atomic(pend);
         const DiameterPush dp{center_scale, static_cast<std::uint32_t>(base), count, first,
                               static_cast<std::uint32_t>(n), max_samples, cos_half,
                               static_cast<std::uint32_t>(options.false_hit), m.cfg.resolution,
-                              1.0f / static_cast<float>(m.cfg.resolution)};
+                              1.0f / static_cast<float>(m.cfg.resolution), static_cast<std::uint32_t>(s)};
         diam.execute([&, dp, cur](PassContext& pc) {
           vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m.diameter.get());
           vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m.diameter.layout.get(), 0, 1,
@@ -536,11 +545,15 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
       check(vkGetQueryPoolResults(m.ctx->device(), m.occlusion.get(), 0, static_cast<std::uint32_t>(steps),
                                   frags.size() * 8, frags.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
             "reading occlusion queries");
+      // Stop after the first step whose layer was empty, or after which no query point can
+      // still be accepted (every candidate lies in front of that back layer).
+      const auto* pending_points = static_cast<const std::uint32_t*>(m.pending.mapped());
       for (int s = 0; s < steps; ++s)
-        if (frags[static_cast<std::size_t>(s)] == 0) {
+        if (frags[static_cast<std::size_t>(s)] == 0 || pending_points[s] == 0) {
           more = false;
-          m.last_layers = std::max(m.last_layers, layer + s - 1);
-          previous_camera_layers = layer + s - 1;
+          const int used = frags[static_cast<std::size_t>(s)] == 0 ? layer + s - 1 : layer + s;
+          m.last_layers = std::max(m.last_layers, used);
+          previous_camera_layers = layer + s;  // passes this camera needed
           break;
         }
       layer += steps;

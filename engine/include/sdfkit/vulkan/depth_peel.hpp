@@ -24,9 +24,11 @@
 //    of back layer k, the closest hit is that front face (open or self-intersecting meshes).
 //  * The closest hit passes the false-intersection rule (Paper: hit normal . start normal <= 0;
 //    Cgal: view direction . hit normal > 0) or the ray is dropped.
-//  * Peeling stops when an occlusion query reports no fragment in the last layer (front and back
-//    layers are counted together when front layers are peeled), or at max_layers (a warning is logged when fragments were
-//    still coming).
+//  * Peeling a camera stops when an occlusion query reports no fragment in the last layer (front
+//    and back layers are counted together when front layers are peeled), when no query point
+//    within the cone lies behind the last back layer any more (the diameter pass counts them:
+//    deeper layers could not give any point a sample), or at max_layers (a warning is logged
+//    when fragments and points were still pending).
 //  * Each point stores at most max_samples_per_point (length, theta) pairs. The default bound
 //    exceeds the number of cameras that can fall inside one cone, so it is never reached; with a
 //    smaller bound, samples past it are dropped (the first ones stored, in camera order, are
