@@ -1,17 +1,12 @@
 #version 450
-// Peel pass, vertex stage. Non-indexed: vertex v is corner v % 3 of triangle v / 3; instance i
-// is camera camera_base + i. Front-facing triangles go to layer 2i, back-facing ones (outward
-// normal along the view direction) to layer 2i + 1; degenerate triangles are moved outside the
-// view volume.
+// Peel pass, vertex stage. Indexed draw of the non-degenerate triangles; instance i is camera
+// camera_base + i. The pass draws twice: front faces (back faces culled) into layer 2i, then back
+// faces (front faces culled) into layer 2i + 1.
 #extension GL_ARB_shader_viewport_layer_array : require
 #extension GL_GOOGLE_include_directive : require
 #include "depth_peel_common.glsl"
 
-struct Triangle {
-  vec4 p[3];   // corner positions (model units)
-  vec4 n;      // outward unit normal, w = 1 (0 = degenerate)
-};
-layout(std430, set = 0, binding = 0) readonly buffer Triangles { Triangle tris[]; };
+layout(location = 0) in vec3 position;  // model units
 layout(std430, set = 0, binding = 1) readonly buffer Cameras { Camera cams[]; };
 
 layout(push_constant) uniform Push {
@@ -19,22 +14,16 @@ layout(push_constant) uniform Push {
   uint camera_base;
   uint first_layer;
   float epsilon;
+  uint back;          // 0: front faces of this draw, 1: back faces
 } pc;
 
-layout(location = 0) flat out vec3 out_normal;
-layout(location = 1) flat out int out_layer;
+layout(location = 0) flat out int out_layer;
 
 void main() {
-  const uint t = uint(gl_VertexIndex) / 3u;
-  const uint corner = uint(gl_VertexIndex) % 3u;
   const Camera cam = cams[pc.camera_base + uint(gl_InstanceIndex)];
-  const vec4 n = tris[t].n;
-  const vec3 p = (tris[t].p[corner].xyz - pc.center_scale.xyz) * pc.center_scale.w;
-  const float facing = dot(n.xyz, cam.dir.xyz);
+  const vec3 p = (position - pc.center_scale.xyz) * pc.center_scale.w;
   gl_Position = vec4(dot(p, cam.right.xyz), dot(p, cam.up.xyz), dot(p, cam.dir.xyz) * 0.5 + 0.5, 1.0);
-  if (n.w == 0.0 || facing == 0.0) gl_Position = vec4(-4.0, -4.0, -4.0, 1.0);
-  const int layer = 2 * gl_InstanceIndex + (facing > 0.0 ? 1 : 0);
+  const int layer = 2 * gl_InstanceIndex + int(pc.back);
   gl_Layer = layer;
   out_layer = layer;
-  out_normal = n.xyz;
 }

@@ -17,6 +17,8 @@ layout(std430, set = 0, binding = 2) buffer Counts { uint counts[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Samples { vec2 samples[]; };
 layout(set = 0, binding = 4) uniform usampler2DArray previous_layer;
 layout(set = 0, binding = 5) uniform usampler2DArray current_layer;
+// Per peel step of a submission: points whose exit may still lie in a deeper layer.
+layout(std430, set = 0, binding = 6) buffer Pending { uint pending[]; };
 
 layout(push_constant) uniform Push {
   vec4 center_scale;    // bounding-sphere centre, 1 / framed radius R
@@ -29,6 +31,7 @@ layout(push_constant) uniform Push {
   uint rule;            // 0 = Paper, 1 = Cgal
   int resolution;
   float front_tolerance;  // normalised depth
+  uint pending_slot;
 } pc;
 
 // Depth of the layer texel at `px`, moved along the surface plane to the sub-pixel position
@@ -72,7 +75,12 @@ void main() {
 
     vec3 back_normal;
     const float z1 = layer_depth(current_layer, px, back, pos, cam, back_normal);
-    if (z1 >= 1.5 || !(zp < z1)) continue;
+    if (z1 >= 1.5) continue;  // no back layer k here: none deeper either
+    if (!(zp < z1)) {
+      // The point lies behind back layer k: a later layer may hold its exit.
+      atomicAdd(pending[pc.pending_slot], 1u);
+      continue;
+    }
     if (pc.first_layer == 0u) {
       vec3 n0;
       const float z0 = layer_depth(previous_layer, px, back, pos, cam, n0);

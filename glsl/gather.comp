@@ -7,7 +7,8 @@ layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer Counts { uint counts[]; };
 layout(std430, set = 0, binding = 1) buffer Samples { vec2 samples[]; };
-layout(std430, set = 0, binding = 2) writeonly buffer Result { uvec2 result[]; };  // value bits, kept
+// Per point: value bits, kept samples, accepted samples (may exceed max_samples), 0.
+layout(std430, set = 0, binding = 2) writeonly buffer Result { uvec4 result[]; };
 
 layout(push_constant) uniform Push {
   uint point_count;
@@ -18,9 +19,10 @@ layout(push_constant) uniform Push {
 void main() {
   const uint i = gl_GlobalInvocationID.x;
   if (i >= pc.point_count) return;
-  const uint k = min(counts[i], pc.max_samples);
+  const uint accepted = counts[i];
+  const uint k = min(accepted, pc.max_samples);
   if (k == 0u) {
-    result[i] = uvec2(floatBitsToUint(0.0), 0u);
+    result[i] = uvec4(floatBitsToUint(0.0), 0u, accepted, 0u);
     return;
   }
   const uint base = i * pc.max_samples;
@@ -56,5 +58,5 @@ void main() {
       ++kept;
     }
   }
-  result[i] = uvec2(floatBitsToUint(wdsum / wsum), kept);
+  result[i] = uvec4(floatBitsToUint(wdsum / wsum), kept, accepted, 0u);
 }

@@ -133,6 +133,8 @@ DeviceInfo describe(VkPhysicalDevice pd, std::uint32_t index, const DeviceRequir
   if (!(v13 || sync_ext) || !sync2.synchronization2) why.push_back("no synchronization2");
   if (req.shader_output_layer && !has_extension(exts, VK_EXT_SHADER_VIEWPORT_INDEX_LAYER_EXTENSION_NAME))
     why.push_back("no VK_EXT_shader_viewport_index_layer (layered rendering)");
+  if (req.geometry_shader && !feats.features.geometryShader)
+    why.push_back("no geometryShader feature (gl_PrimitiveID in fragment shaders)");
   VkFormatProperties fp{};
   vkGetPhysicalDeviceFormatProperties(pd, VK_FORMAT_D32_SFLOAT, &fp);
   if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))

@@ -6,6 +6,7 @@
 #include "analytic.hpp"
 #include "compare.hpp"
 
+#include "sdfkit/core/log.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/vulkan/depth_peel.hpp"
 
@@ -112,6 +113,103 @@ TEST(DepthPeel, AnalyticShapesMatchTheIdealEstimator) {
     EXPECT_LT(test::median_relative_difference(a, b), c.max_median_rel) << c.name;
     EXPECT_LT(test::quantile_relative_difference(a, b, 0.9), c.max_p90_rel) << c.name;
     EXPECT_LT(std::fabs(test::median_signed_relative_difference(a, b)), 0.01) << c.name;  // no bias
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+// A session reused on moved vertices: scaling the capsule by 2 scales the framing with it, so
+// every image is the same up to rounding and every value doubles.
+TEST(DepthPeel, UpdatePositionsReusesTheSessionAndScalesValues) {
+  auto be = make_backend(small_config(32, 128));
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  const Mesh m = shapes::capsule(1.0f, 4.0f, 32, 16);
+  Mesh big = m;
+  for (auto& p : big.positions) p *= 2.0f;
+  SdfOptions o;
+  be->set_mesh(m);
+  const SdfField a = compute_sdf(*be, m, o);
+  be->update_positions(big.positions);
+  const SdfField b = compute_sdf(*be, big, o);
+  be->update_positions(m.positions);
+  const SdfField c = compute_sdf(*be, m, o);
+  ASSERT_EQ(a.values.size(), b.values.size());
+  for (std::size_t i = 0; i < a.values.size(); ++i) {
+    EXPECT_NEAR(b.values[i], 2.0f * a.values[i], 1e-3f * a.values[i]) << i;
+    EXPECT_EQ(c.values[i], a.values[i]) << i;  // deterministic
+  }
+  EXPECT_THROW(be->update_positions(std::vector<glm::vec3>(3)), Error);
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
+  DepthPeelConfig cfg = small_config(32, 128);
+  cfg.max_layers = 1;
+  auto be = make_backend(cfg);
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  // A torus has up to 4 layers along most views; with the cap at 1 only the outermost count.
+  const Mesh m = shapes::torus(3.0f, 1.0f, 48, 24);
+  be->set_mesh(m);
+  std::vector<std::string> warnings;
+  set_log_sink([&](LogLevel level, std::string_view msg) {
+    if (level == LogLevel::Warning) warnings.emplace_back(msg);
+  });
+  const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
+  set_log_sink(nullptr);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("max_layers = 1"), std::string::npos) << warnings[0];
+  EXPECT_EQ(be->last_layer_count(), 1);
+  std::size_t valued = 0;
+  for (auto k : r.kept_rays) valued += k > 0;
+  EXPECT_GT(valued, m.vertex_count() / 2);
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+// On a closed manifold mesh front layers cannot hold the closest hit, so Auto (back layers
+// only) and Always (the paper's alternation) give the same field.
+TEST(DepthPeel, FrontLayersDoNotChangeClosedMeshes) {
+  DepthPeelConfig cfg = small_config(32, 128);
+  auto auto_be = make_backend(cfg);
+  if (!auto_be) GTEST_SKIP() << "no Vulkan device";
+  cfg.front_layers = FrontLayers::Always;
+  auto always_be = make_backend(cfg);
+  const Mesh m = shapes::torus(3.0f, 1.0f, 48, 24);
+  auto_be->set_mesh(m);
+  always_be->set_mesh(m);
+  EXPECT_FALSE(auto_be->peels_front_layers());
+  EXPECT_TRUE(always_be->peels_front_layers());
+  for (FalseHitRule rule : {FalseHitRule::Paper, FalseHitRule::Cgal}) {
+    SdfOptions o;
+    o.false_hit = rule;
+    const SdfQuery q = make_query(m, o.domain);
+    const RawSdf a = auto_be->compute(q, o), b = always_be->compute(q, o);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.values.size(); ++i) differ += a.values[i] != b.values[i];
+    EXPECT_LE(differ, a.values.size() / 200);  // at most grazing-angle pixels differ
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(auto_be->context());
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(always_be->context());
+}
+
+// Past max_samples_per_point the extra samples are dropped with one warning; the first ones
+// stored still make a value.
+TEST(DepthPeel, SamplesPastTheBoundAreDroppedWithAWarning) {
+  DepthPeelConfig cfg = small_config(32, 128);
+  cfg.max_samples_per_point = 2;
+  auto be = make_backend(cfg);
+  if (!be) GTEST_SKIP() << "no Vulkan device";
+  const Mesh m = shapes::capsule(1.0f, 4.0f, 24, 12);
+  be->set_mesh(m);
+  std::vector<std::string> warnings;
+  set_log_sink([&](LogLevel level, std::string_view msg) {
+    if (level == LogLevel::Warning) warnings.emplace_back(msg);
+  });
+  const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
+  set_log_sink(nullptr);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("more than 2 accepted views"), std::string::npos) << warnings[0];
+  for (std::size_t i = 0; i < r.values.size(); ++i) {
+    EXPECT_LE(r.kept_rays[i], 2u);
+    EXPECT_TRUE(std::isfinite(r.values[i]));
   }
   SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
 }

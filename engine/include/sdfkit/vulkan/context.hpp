@@ -22,6 +22,7 @@ class Allocator;
 // graphics+compute queue, dynamic rendering, synchronization2).
 struct DeviceRequirements {
   bool shader_output_layer = false;  // gl_Layer written by the vertex shader (layered rendering)
+  bool geometry_shader = false;      // also what gl_PrimitiveID in fragment shaders needs
 };
 
 struct ContextConfig {
