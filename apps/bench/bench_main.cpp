@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   app.add_option("--resolution", o.resolution, "Vulkan resolution (0 = default)");
   app.add_option("--repeats", o.repeats, "Warm repeats per backend");
   app.add_option("--device", o.device, "GPU device selector");
+  app.add_flag("--profile", o.profile, "Per-pass GPU timestamps (Vulkan) in the stage table");
   app.add_flag("--large", large, "Add bunny00 subdivided (~150k vertices) and armadillo subdivided twice (~416k)");
   app.add_flag("--meshlab", o.meshlab, "Also time MeshLab's GPU SDF filter (meshlabserver, xvfb-run)");
   app.add_flag("--no-cgal", no_cgal, "Skip CGAL's sdf_values");

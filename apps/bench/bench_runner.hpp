@@ -32,6 +32,7 @@ struct BenchOptions {
   int smooth_rings = 2;
   std::string cgal_helper;   // path of sdfkit-cgal-sdf ("" = next to this program)
   std::string device;        // device selector passed to the GPU backends
+  bool profile = false;      // per-pass GPU timestamps (Vulkan) in the stage table
 };
 
 struct BackendRun {
