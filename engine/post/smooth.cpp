@@ -7,12 +7,36 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <thread>
 
 namespace sdfkit {
 
 namespace {
+
+// exp(x) for x <= 0 to about 2e-7 relative error: 2^(x log2 e) split into an integer power (built
+// in the exponent bits) and 2^f for f in [0, 1) by a degree-6 polynomial. Inlined and branch-light
+// so the weighting loop vectorises; underflows to 0 below -87.
+inline float exp_nonpositive(float x) {
+  x = std::max(x, -87.0f);
+  const float t = x * 1.44269504088896341f;
+  const float fi = std::floor(t);
+  const float f = t - fi;
+  float p = 1.53559640e-4f;
+  p = p * f + 1.33989500e-3f;
+  p = p * f + 9.61817205e-3f;
+  p = p * f + 5.55036850e-2f;
+  p = p * f + 2.40226510e-1f;
+  p = p * f + 6.93147182e-1f;
+  p = p * f + 1.0f;
+  const std::int32_t bits = (static_cast<std::int32_t>(fi) + 127) << 23;
+  float scale;
+  std::memcpy(&scale, &bits, sizeof scale);
+  return p * scale;
+}
+
 // Mean length of the unique edges of a vertex adjacency.
 float mean_edge_length(const Mesh& mesh, const Adjacency& adj) {
   double sum = 0.0;
@@ -84,7 +108,7 @@ std::vector<float> smooth_field(const Mesh& mesh, SdfDomain domain, std::span<co
       float wsum = 0.0f, vsum = 0.0f;
       for (std::uint32_t q : hood) {
         const glm::vec3 d = points[q] - c;
-        const float w = std::exp(-(d.x * d.x + d.y * d.y + d.z * d.z) * inv_two_sigma2);
+        const float w = exp_nonpositive(-(d.x * d.x + d.y * d.y + d.z * d.z) * inv_two_sigma2);
         wsum += w;
         vsum += w * values[q];
       }

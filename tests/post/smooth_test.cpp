@@ -3,6 +3,7 @@
 #include "sdfkit/core/topology.hpp"
 #include "sdfkit/post/smooth.hpp"
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -74,4 +75,26 @@ TEST(Smooth, RejectsBadArguments) {
   o.rings = 0;
   EXPECT_THROW(smooth_field(m, SdfDomain::Vertex, std::vector<float>(m.positions.size()), o), InputError);
   EXPECT_THROW(smooth_field(m, SdfDomain::Vertex, std::vector<float>(3), {}), Error);
+}
+
+TEST(Smooth, FastGaussianWeightsMatchStdExp) {
+  // The weights use an inlined exp; compare a smoothing against the definition with std::exp.
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 2}};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  const std::vector<float> v = {1, 2, 3, 4};
+  for (float sigma : {0.05f, 0.3f, 1.0f, 7.0f}) {
+    SmoothOptions o;
+    o.rings = 1;
+    o.sigma = sigma;
+    const auto s = smooth_field(m, SdfDomain::Vertex, v, o);
+    double ws = 0, vs = 0;
+    for (int j = 0; j < 4; ++j) {
+      const double d2 = glm::dot(m.positions[j], m.positions[j]);
+      const double w = std::exp(-d2 / (2.0 * sigma * sigma));
+      ws += w;
+      vs += w * v[j];
+    }
+    EXPECT_NEAR(s[0], vs / ws, 1e-5 * vs / ws) << sigma;
+  }
 }
