@@ -264,6 +264,52 @@ tinygltf::Model fresh_model(const Asset& asset, const OutputValues& values,
   return model;
 }
 
+// Adds each overlay as a mesh (a LINES and a TRIANGLES primitive over one POSITION accessor)
+// on a node of its own at the root of the default scene.
+void add_overlays(tinygltf::Model& model, const std::vector<Overlay>& overlays) {
+  if (overlays.empty()) return;
+  if (model.buffers.empty()) model.buffers.emplace_back();
+  BufferAppender appender(model);
+  if (model.scenes.empty()) {
+    model.scenes.emplace_back();
+    model.defaultScene = 0;
+  }
+  const auto scene = static_cast<std::size_t>(model.defaultScene >= 0 ? model.defaultScene : 0);
+  for (const Overlay& o : overlays) {
+    if (o.points.empty() || (o.lines.empty() && o.triangles.empty())) continue;
+    for (const auto& l : o.lines)
+      if (l[0] >= o.points.size() || l[1] >= o.points.size())
+        throw Error("overlay '" + o.name + "': a line uses a point index out of range");
+    for (const auto& t : o.triangles)
+      if (t[0] >= o.points.size() || t[1] >= o.points.size() || t[2] >= o.points.size())
+        throw Error("overlay '" + o.name + "': a triangle uses a point index out of range");
+    const int position = appender.add_floats(&o.points[0].x, o.points.size(), TINYGLTF_TYPE_VEC3,
+                                             TINYGLTF_TARGET_ARRAY_BUFFER, true);
+    tinygltf::Mesh mesh;
+    mesh.name = o.name;
+    if (!o.lines.empty()) {
+      tinygltf::Primitive prim;
+      prim.mode = TINYGLTF_MODE_LINE;
+      prim.attributes["POSITION"] = position;
+      prim.indices = appender.add_indices(o.lines.data()->data(), o.lines.size() * 2);
+      mesh.primitives.push_back(std::move(prim));
+    }
+    if (!o.triangles.empty()) {
+      tinygltf::Primitive prim;
+      prim.mode = TINYGLTF_MODE_TRIANGLES;
+      prim.attributes["POSITION"] = position;
+      prim.indices = appender.add_indices(o.triangles.data()->data(), o.triangles.size() * 3);
+      mesh.primitives.push_back(std::move(prim));
+    }
+    model.meshes.push_back(std::move(mesh));
+    tinygltf::Node node;
+    node.name = o.name;
+    node.mesh = static_cast<int>(model.meshes.size() - 1);
+    model.nodes.push_back(std::move(node));
+    model.scenes[scene].nodes.push_back(static_cast<int>(model.nodes.size() - 1));
+  }
+}
+
 }  // namespace
 
 void write_gltf(std::ostream& out, bool binary, const Asset& asset, const OutputValues& values,
@@ -277,8 +323,9 @@ void write_gltf(std::ostream& out, bool binary, const Asset& asset, const Output
     throw Error(asset.path + ": the glTF asset has lost its source model");
   if (asset.input_positions.empty() || asset.input_triangles.empty())
     throw InputError(asset.path + ": the mesh has no triangles");
-  const tinygltf::Model model = src ? write_back_model(*src, binary, values, options, warnings)
-                                    : fresh_model(asset, values, options);
+  tinygltf::Model model = src ? write_back_model(*src, binary, values, options, warnings)
+                              : fresh_model(asset, values, options);
+  add_overlays(model, options.overlays);
   tinygltf::TinyGLTF writer;
   writer.SetImageWriter(&embed_image, nullptr);
   if (!writer.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!binary, binary))

@@ -12,6 +12,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <array>
 #include <functional>
 #include <iosfwd>
 #include <memory>
@@ -62,9 +63,19 @@ struct Asset {
 // non-finite coordinates or a file without any triangle.
 Asset load_asset(const std::string& path, const LoadOptions& options = {});
 
+// Extra geometry written into glTF outputs as a node of its own at the scene root (a
+// skeleton): points in world units, lines and triangles between them. PLY and txt ignore it.
+struct Overlay {
+  std::string name;
+  std::vector<glm::vec3> points;
+  std::vector<std::array<std::uint32_t, 2>> lines;
+  std::vector<Triangle> triangles;
+};
+
 struct WriteOptions {
   bool color = true;        // glTF COLOR_0, PLY red/green/blue from colormap(normalized value)
   bool normalized = false;  // .txt and PLY quality hold the [0,1] normalized value
+  std::vector<Overlay> overlays;  // glTF only
 };
 
 // Writes `field` (computed on asset.mesh) to out_path; the format follows the extension:
