@@ -19,6 +19,13 @@
 namespace sdfkit {
 namespace {
 
+io::WriteOptions write_options(bool color, bool normalized) {
+  io::WriteOptions o;
+  o.color = color;
+  o.normalized = normalized;
+  return o;
+}
+
 using test::GltfBuilder;
 using test::ScratchDir;
 
@@ -234,7 +241,7 @@ TEST(WriteGltf, WithoutColorKeepsTheInputColors) {
   ScratchDir dir;
   const io::Asset a = io::load_asset(write_textured_input(dir).path);
   const std::string out = dir.path("plain.glb");
-  io::write_field(out, a, ramp_field(a, SdfDomain::Vertex), {.color = false});
+  io::write_field(out, a, ramp_field(a, SdfDomain::Vertex), write_options(false, false));
   const tinygltf::Model m = load_model(out);
   const std::vector<float> rgb = floats_of(m, m.meshes[0].primitives[0].attributes.at("COLOR_0"));
   for (float c : rgb) EXPECT_EQ(c, 0.5f);
@@ -387,7 +394,7 @@ TEST(WritePly, PerFaceNormalizedWithoutColor) {
   const io::Asset a = io::load_asset(dir.write("cube.off", kCubeOff));
   const SdfField field = ramp_field(a, SdfDomain::Face);
   const std::string out = dir.path("faces.PLY");
-  io::write_field(out, a, field, {.color = false, .normalized = true});
+  io::write_field(out, a, field, write_options(false, true));
   const ParsedPly p = parse_sdfkit_ply(test::read_bytes(out), false, false);
   EXPECT_EQ(p.header.find("red"), std::string::npos);
   EXPECT_NE(p.header.find("property list uchar int vertex_indices\nproperty float quality"),
@@ -423,7 +430,7 @@ TEST(WriteTxt, OneValuePerInputVertexOrFaceExactly) {
   ASSERT_EQ(v.size(), 6u);
   for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(v[i], vertex_value(a, field, i));
 
-  io::write_field(dir.path("n.txt"), a, field, {.normalized = true});
+  io::write_field(dir.path("n.txt"), a, field, write_options(true, true));
   const std::vector<float> n = parse_lines(test::read_bytes(dir.path("n.txt")));
   const std::vector<float> expected = normalized(field.values);
   for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(n[i], expected[a.input_to_welded[i]]);
@@ -460,7 +467,7 @@ TEST(RoundTrip, EveryInputFormatThroughEveryMeshOutput) {
     const SdfField field = ramp_field(a, SdfDomain::Vertex);
     for (const char* ext : {"ply", "glb", "gltf"}) {
       const std::string out = input + ".out." + ext;
-      io::write_field(out, a, field, {.color = false});
+      io::write_field(out, a, field, write_options(false, false));
       const io::Asset back = io::load_asset(out);
       EXPECT_EQ(back.input_positions, a.input_positions) << out;
       EXPECT_EQ(back.input_triangles, a.input_triangles) << out;
