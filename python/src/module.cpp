@@ -129,7 +129,10 @@ Polygons are fan-triangulated; triangle order is the file's.)doc")
             field.domain = parse_domain(per);
             field.values = to_values(values, "values");
             py::gil_scoped_release unlocked;
-            io::write_field(path, a, field, io::WriteOptions{color, normalize});
+            io::WriteOptions options;
+            options.color = color;
+            options.normalized = normalize;
+            io::write_field(path, a, field, options);
           },
           "path"_a, "values"_a, py::kw_only(), "per"_a = "vertex", "color"_a = true, "normalize"_a = false,
           R"doc(Writes a field computed on this asset's welded mesh, atomically; format by extension.
@@ -259,7 +262,8 @@ void bind_functions(py::module_& m) {
         request.sdf = make_options(per, rays, cone, false_hits);
         if (smooth < 0) throw InputError("smooth must be >= 0 rings (0 = off), got " + std::to_string(smooth));
         request.smooth_rings = smooth;
-        request.write = io::WriteOptions{color, normalize};
+        request.write.color = color;
+        request.write.normalized = normalize;
         if (!(weld_tolerance >= 0.0f))
           throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
         request.load.weld_tolerance = weld_tolerance;
