@@ -2,10 +2,10 @@
 # Installs a built sdfkit into <build>/install, then builds the outside project
 # examples/custom_pass against that package (find_package(sdfkit)) and runs it on Mesa lavapipe
 # with the validation layer on. Exits non-zero on any failure.
-#   scripts/test-example.sh [BUILD_DIR]   (default: build)
+#   scripts/test-example.sh [BUILD_DIR]   (default: the repository's build/)
 set -euo pipefail
+build="$(realpath "${1:-$(dirname "$0")/../build}")"
 cd "$(dirname "$0")/.."
-build="$(realpath "${1:-build}")"
 prefix="$build/install"
 example_build="$build/example-custom_pass"
 
