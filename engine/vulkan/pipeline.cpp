@@ -63,18 +63,25 @@ UniquePipelineLayout make_layout(VkDevice device, VkDescriptorSetLayout set, std
 
 Pipeline create_compute_pipeline(Context& ctx, std::string_view shader,
                                  std::span<const VkDescriptorType> bindings, std::uint32_t push_bytes) {
+  return create_compute_pipeline(ctx, embedded_spirv(shader), bindings, push_bytes, shader);
+}
+
+Pipeline create_compute_pipeline(Context& ctx, std::span<const std::uint32_t> spirv,
+                                 std::span<const VkDescriptorType> bindings, std::uint32_t push_bytes,
+                                 std::string_view label) {
+  if (spirv.empty()) throw Error("the SPIR-V of compute shader " + std::string(label) + " is empty");
   VkDevice dev = ctx.device();
   Pipeline p;
   p.set_layout = create_set_layout(dev, bindings, VK_SHADER_STAGE_COMPUTE_BIT);
   p.layout = make_layout(dev, p.set_layout.get(), push_bytes, VK_SHADER_STAGE_COMPUTE_BIT);
-  UniqueShaderModule module = create_shader_module(dev, embedded_spirv(shader));
+  UniqueShaderModule module = create_shader_module(dev, spirv);
   VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT,
               module.get(), "main", nullptr};
   ci.layout = p.layout.get();
   VkPipeline pl = VK_NULL_HANDLE;
   check(vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &pl),
-        ("creating the compute pipeline " + std::string(shader)).c_str());
+        ("creating the compute pipeline " + std::string(label)).c_str());
   p.pipeline = UniquePipeline(dev, pl);
   return p;
 }

@@ -35,6 +35,12 @@ UniqueDescriptorSetLayout create_set_layout(VkDevice device, std::span<const VkD
 Pipeline create_compute_pipeline(Context& ctx, std::string_view shader,
                                  std::span<const VkDescriptorType> bindings, std::uint32_t push_bytes);
 
+// The same from the caller's own SPIR-V (entry point "main"), for embedding projects that compile
+// their shaders themselves; `label` names the shader in error messages.
+Pipeline create_compute_pipeline(Context& ctx, std::span<const std::uint32_t> spirv,
+                                 std::span<const VkDescriptorType> bindings, std::uint32_t push_bytes,
+                                 std::string_view label = "(caller's SPIR-V)");
+
 // What a graphics pipeline for dynamic rendering needs beyond its shaders.
 struct GraphicsPipelineDescription {
   std::string_view vertex_shader, fragment_shader;
