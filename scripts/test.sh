@@ -17,6 +17,9 @@ unset SDFKIT_ALLOW_NO_DEVICE
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j2 --timeout 600
 
+# Embedding: install the CMake package and build + run examples/custom_pass against it.
+scripts/test-example.sh build
+
 if [ "${SDFKIT_SKIP_SANITIZE:-0}" != "1" ]; then
   SDFKIT_BUILD_DIR=build-asan scripts/build.sh -DSDFKIT_SANITIZE=ON -DSDFKIT_WITH_VULKAN=OFF \
     -DSDFKIT_WITH_OPENCL=OFF -DSDFKIT_BUILD_BENCH=OFF
