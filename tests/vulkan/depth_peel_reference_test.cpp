@@ -22,7 +22,7 @@ namespace {
 
 Mesh load(const std::string& name) { return io::load_asset(test::data_mesh(name)).mesh; }
 
-std::unique_ptr<DepthPeelBackend> make_backend(int views, int resolution, PeelMode mode = PeelMode::Layers) {
+std::unique_ptr<DepthPeelBackend> make_backend(int views, int resolution, PeelMode mode = DepthPeelConfig{}.mode) {
   DepthPeelConfig cfg;
   cfg.mode = mode;
   cfg.views = views;
@@ -82,9 +82,9 @@ TEST(DepthPeelReference, RealMeshesMatchEmbree) {
 // The fragment-list mode against the paper's peeling on a CGAL mesh (closed: the same surfaces
 // are found, so the fields agree up to rounding), and both against Embree.
 TEST(DepthPeelReference, FragmentListsAgreeWithLayersOnARealMesh) {
-  auto layers = make_backend(64, 256);
+  auto layers = make_backend(64, 128, PeelMode::Layers);
   if (!layers) GTEST_SKIP() << "no Vulkan device";
-  auto lists = make_backend(64, 256, PeelMode::FragmentLists);
+  auto lists = make_backend(64, 128, PeelMode::FragmentLists);
   const Mesh m = load("elephant.off");
   const SdfOptions o;
   layers->set_mesh(m);

@@ -144,6 +144,7 @@ TEST(DepthPeel, UpdatePositionsReusesTheSessionAndScalesValues) {
 TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
   DepthPeelConfig cfg = small_config(32, 128);
   cfg.max_layers = 1;
+  cfg.mode = PeelMode::Layers;
   auto be = make_backend(cfg);
   if (!be) GTEST_SKIP() << "no Vulkan device";
   // A torus has up to 4 layers along most views; with the cap at 1 only the outermost count.
@@ -168,6 +169,7 @@ TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
 // only) and Always (the paper's alternation) give the same field.
 TEST(DepthPeel, FrontLayersDoNotChangeClosedMeshes) {
   DepthPeelConfig cfg = small_config(32, 128);
+  cfg.mode = PeelMode::Layers;
   auto auto_be = make_backend(cfg);
   if (!auto_be) GTEST_SKIP() << "no Vulkan device";
   cfg.front_layers = FrontLayers::Always;
@@ -253,6 +255,7 @@ Mesh open_torus() {
 // only), the paper's front/back alternation, an open mesh (front hits), both false-hit rules.
 TEST(DepthPeel, FragmentListsAgreeWithLayers) {
   DepthPeelConfig cfg = small_config(32, 128);
+  cfg.mode = PeelMode::Layers;
   auto layers = make_backend(cfg);
   if (!layers) GTEST_SKIP() << "no Vulkan device";
   cfg.mode = PeelMode::FragmentLists;
