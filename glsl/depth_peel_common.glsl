@@ -26,3 +26,17 @@ vec3 decode_normal(uint bits) {
   if (n.z < 0.0) n.xy = oct_wrap(n.xy);
   return normalize(n);
 }
+
+// A fragment's depth (stored at the centre of texel `px`), moved along the plane of its surface
+// (outward unit normal `normal`) to the sub-pixel position `pos` (pixels) of a query point, the
+// move limited to two pixels' depth. Plane: d(depth)/d(image x) = -n_right / n_dir (model
+// units); one pixel is 2R/res model units, one unit of normalised depth is 2R model units.
+float corrected_depth(float z, vec3 normal, ivec2 px, vec2 pos, Camera cam, int resolution) {
+  const float nd = dot(normal, cam.dir.xyz);
+  const float nd_safe = nd >= 0.0 ? max(nd, 0.2) : min(nd, -0.2);
+  const vec2 delta = clamp(pos - (vec2(px) + 0.5), vec2(-0.5), vec2(0.5));
+  const float slope_r = -dot(normal, cam.right.xyz) / nd_safe;
+  const float slope_u = -dot(normal, cam.up.xyz) / nd_safe;
+  const float dz = (slope_r * delta.x + slope_u * delta.y) / float(resolution);
+  return z + clamp(dz, -2.0 / float(resolution), 2.0 / float(resolution));
+}

@@ -42,15 +42,7 @@ float layer_depth(usampler2DArray layer_image, ivec2 px, int layer, vec2 pos, Ca
   normal = vec3(0.0);
   if (z >= 1.5) return kNoSurface;
   normal = decode_normal(t.y);
-  // Plane through the texel centre: d(depth)/d(image x) = -n_right / n_dir (model units);
-  // one pixel is 2R/res model units, one unit of normalised depth is 2R model units.
-  const float nd = dot(normal, cam.dir.xyz);
-  const float nd_safe = nd >= 0.0 ? max(nd, 0.2) : min(nd, -0.2);
-  const vec2 delta = clamp(pos - (vec2(px) + 0.5), vec2(-0.5), vec2(0.5));
-  const float slope_r = -dot(normal, cam.right.xyz) / nd_safe;
-  const float slope_u = -dot(normal, cam.up.xyz) / nd_safe;
-  const float dz = (slope_r * delta.x + slope_u * delta.y) / float(pc.resolution);
-  return z + clamp(dz, -2.0 / float(pc.resolution), 2.0 / float(pc.resolution));
+  return corrected_depth(z, normal, px, pos, cam, pc.resolution);
 }
 
 void main() {

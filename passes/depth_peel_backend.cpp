@@ -55,6 +55,28 @@ struct DiameterPush {
   float front_tolerance;
   std::uint32_t pending_slot;
 };
+struct ListPush {
+  glm::vec4 center_scale;
+  std::uint32_t camera_base;
+  std::int32_t resolution;
+  std::uint32_t capacity;
+};
+struct ResolvePush {
+  glm::vec4 center_scale;
+  std::uint32_t camera_base;
+  std::uint32_t camera_count;
+  std::uint32_t point_count;
+  std::uint32_t max_samples;
+  float cos_half_cone;
+  std::uint32_t rule;
+  std::int32_t resolution;
+  float front_tolerance;
+  std::uint32_t capacity;
+};
+// Fragment-list node: depth | facing, normal, next (fragment_list_common.glsl).
+constexpr VkDeviceSize kNodeBytes = 12;
+// The fragment-list pass's colour attachment only gives the render area (nothing reads it).
+constexpr VkFormat kListTargetFormat = VK_FORMAT_R8_UINT;
 struct GatherPush {
   std::uint32_t point_count;
   std::uint32_t max_samples;
@@ -87,6 +109,13 @@ const VkDescriptorType kDiameterBindings[] = {
     VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+const VkDescriptorType kListBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                          VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                          VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+const VkDescriptorType kResolveBindings[] = {
+    VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
 const VkDescriptorType kGatherBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
 
@@ -135,6 +164,17 @@ struct DepthPeelBackend::Impl {
   std::size_t point_capacity = 0, sample_capacity = 0;
   Buffer points, counts, samples, result;
 
+  // FragmentLists mode (see PeelMode).
+  bool lists = false;
+  Pipeline list_all, list_back, resolve;  // list_*: identical layouts; list_back culls front faces
+  UniqueDescriptorPool list_pool;
+  VkDescriptorSet list_set = VK_NULL_HANDLE, resolve_set = VK_NULL_HANDLE;
+  Buffer heads;    // batch x res^2 list heads
+  Buffer nodes;    // node_capacity x kNodeBytes
+  Buffer counter;  // fragments appended by the last batch (host-read)
+  std::size_t node_capacity = 0;
+  std::size_t dropped = 0;
+
   std::vector<StageTiming> timings;
   int last_layers = 0;
 
@@ -142,6 +182,11 @@ struct DepthPeelBackend::Impl {
   void upload_geometry(std::span<const glm::vec3> positions);
   void ensure_query_buffers(std::size_t n, std::uint32_t max_samples);
   void write_sets();
+  void create_list_resources();
+  void grow_nodes(std::size_t capacity);
+  // FragmentLists: list and resolve passes for every camera; samples into counts/samples.
+  void run_lists(std::size_t n, std::uint32_t max_samples, float cos_half, FalseHitRule rule,
+                 std::vector<PassTiming>& gpu);
   std::uint32_t auto_max_samples(float cone_degrees) const;
   // Gather pass; with upload_* (host-visible), copies them into counts/samples first.
   RawSdf run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu,
@@ -225,6 +270,50 @@ DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
   VkQueryPool qp = VK_NULL_HANDLE;
   check(vkCreateQueryPool(dev, &qi, nullptr, &qp), "creating the occlusion query pool");
   occlusion = UniqueQueryPool(dev, qp);
+  if (cfg.mode == PeelMode::FragmentLists) create_list_resources();
+}
+
+void DepthPeelBackend::Impl::create_list_resources() {
+  lists = true;
+  // Cameras per batch: one raster pass (instanced) and one resolve pass per batch.
+  batch = cfg.cameras_per_batch > 0 ? std::min(cfg.cameras_per_batch, cfg.views) : std::min(8, cfg.views);
+  VkDevice dev = ctx->device();
+  GraphicsPipelineDescription gd;
+  gd.vertex_shader = "fragment_list.vert";
+  gd.fragment_shader = "fragment_list.frag";
+  gd.bindings.assign(std::begin(kListBindings), std::end(kListBindings));
+  gd.push_bytes = sizeof(ListPush);
+  gd.vertex_stride = sizeof(glm::vec3);
+  gd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+  gd.color_formats = {kListTargetFormat};
+  gd.cull = VK_CULL_MODE_NONE;
+  list_all = create_graphics_pipeline(*ctx, gd);
+  gd.cull = VK_CULL_MODE_FRONT_BIT;
+  list_back = create_graphics_pipeline(*ctx, gd);
+  resolve = create_compute_pipeline(*ctx, "fragment_list.comp", kResolveBindings, sizeof(ResolvePush));
+  std::vector<VkDescriptorType> all(std::begin(kListBindings), std::end(kListBindings));
+  all.insert(all.end(), std::begin(kResolveBindings), std::end(kResolveBindings));
+  list_pool = create_descriptor_pool(dev, all, 2);
+  list_set = allocate_set(dev, list_pool.get(), list_all.set_layout.get());
+  resolve_set = allocate_set(dev, list_pool.get(), resolve.set_layout.get());
+
+  const auto pixels = static_cast<VkDeviceSize>(cfg.resolution) * static_cast<VkDeviceSize>(cfg.resolution);
+  heads = create_buffer(*ctx, 4 * pixels * static_cast<VkDeviceSize>(batch),
+                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::DeviceLocal);
+  counter = create_buffer(*ctx, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                          MemoryUse::Readback);
+  grow_nodes(cfg.fragment_capacity > 0 ? cfg.fragment_capacity : static_cast<std::size_t>(pixels) * batch);
+}
+
+void DepthPeelBackend::Impl::grow_nodes(std::size_t capacity) {
+  const VkDeviceSize limit = ctx->capabilities().max_storage_buffer_range / kNodeBytes;
+  if (capacity > limit)
+    throw DeviceError("the fragment lists of one batch of " + std::to_string(batch) + " cameras need " +
+                      std::to_string(capacity) + " nodes, more than the device's storage buffer range holds (" +
+                      std::to_string(limit) + "); use fewer cameras per batch or a lower resolution");
+  nodes = Buffer{};  // release the old buffer first
+  nodes = create_buffer(*ctx, capacity * kNodeBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::DeviceLocal);
+  node_capacity = capacity;
 }
 
 void DepthPeelBackend::Impl::upload_geometry(std::span<const glm::vec3> positions) {
@@ -324,6 +413,114 @@ void DepthPeelBackend::Impl::write_sets() {
                                   {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, result.get()}};
     write_set(dev, gather_set, gw);
   }
+  if (lists && normal_buffer.buffer) {
+    const DescriptorWrite lw[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, normal_buffer.get()},
+                                  {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, camera_buffer.get()},
+                                  {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, heads.get()},
+                                  {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, nodes.get()},
+                                  {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, counter.get()}};
+    write_set(dev, list_set, lw);
+  }
+  if (lists && points.buffer) {
+    const DescriptorWrite rw[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, camera_buffer.get()},
+                                  {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, points.get()},
+                                  {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, counts.get()},
+                                  {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, samples.get()},
+                                  {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, heads.get()},
+                                  {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, nodes.get()},
+                                  {6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, counter.get()}};
+    write_set(dev, resolve_set, rw);
+  }
+}
+
+void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples, float cos_half, FalseHitRule rule,
+                                       std::vector<PassTiming>& gpu) {
+  const glm::vec4 center_scale(center, 1.0f / (radius * kFrameMargin));
+  const auto res = static_cast<std::uint32_t>(cfg.resolution);
+  const ImageInfo target_info{kListTargetFormat, res, res, 1};
+  const auto index_count = static_cast<std::uint32_t>(3 * drawn.size());
+  const auto groups = static_cast<std::uint32_t>((n + 63) / 64);
+  const Pipeline& raster = front_layers ? list_all : list_back;
+  dropped = 0;
+  for (int base = 0; base < cfg.views;) {
+    const auto count = static_cast<std::uint32_t>(std::min(batch, cfg.views - base));
+    RenderGraph g;
+    auto cnt = g.import_buffer("counts", counts.size, {counts.get()});
+    auto smp = g.import_buffer("samples", samples.size, {samples.get()});
+    auto pos = g.import_buffer("positions", position_buffer.size, {position_buffer.get()});
+    auto idx = g.import_buffer("indices", index_buffer.size, {index_buffer.get()});
+    auto hd = g.import_buffer("list_heads", heads.size, {heads.get()});
+    auto nd = g.import_buffer("list_nodes", nodes.size, {nodes.get()});
+    auto ctr = g.import_buffer("list_counter", counter.size, {counter.get()});
+    if (base == 0) {
+      auto clear = g.add_pass("clear_counts", PassKind::Transfer);
+      cnt = clear.transfer_dst(cnt);
+      clear.execute([&, cnt](PassContext& pc) { vkCmdFillBuffer(pc.cmd, pc.buffer(cnt), 0, VK_WHOLE_SIZE, 0); });
+    }
+    auto reset = g.add_pass("reset_lists", PassKind::Transfer);
+    hd = reset.transfer_dst(hd);
+    ctr = reset.transfer_dst(ctr);
+    reset.execute([&, hd, ctr](PassContext& pc) {
+      vkCmdFillBuffer(pc.cmd, pc.buffer(hd), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);  // kEndOfList
+      vkCmdFillBuffer(pc.cmd, pc.buffer(ctr), 0, VK_WHOLE_SIZE, 0);
+    });
+    auto list = g.add_pass("fragment_lists", PassKind::Graphics);
+    list.color(g.create_image("list_target", target_info), LoadOp::DontCare);
+    list.vertex(pos);
+    list.index(idx);
+    hd = list.atomic(hd);
+    ctr = list.atomic(ctr);
+    nd = list.storage_write(nd);
+    const ListPush lp{center_scale, static_cast<std::uint32_t>(base), cfg.resolution,
+                      static_cast<std::uint32_t>(node_capacity)};
+    list.execute([&, lp, count](PassContext& pc) {
+      const VkDeviceSize zero = 0;
+      const VkBuffer vb = pc.buffer(pos);
+      vkCmdBindVertexBuffers(pc.cmd, 0, 1, &vb, &zero);
+      vkCmdBindIndexBuffer(pc.cmd, pc.buffer(idx), 0, VK_INDEX_TYPE_UINT32);
+      vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, raster.get());
+      vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, raster.layout.get(), 0, 1, &list_set, 0,
+                              nullptr);
+      vkCmdPushConstants(pc.cmd, raster.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                         sizeof(lp), &lp);
+      vkCmdDrawIndexed(pc.cmd, index_count, count, 0, 0, 0);
+    });
+    auto rs = g.add_pass("resolve_lists", PassKind::Compute);
+    rs.storage_read(hd);
+    rs.storage_read(nd);
+    rs.storage_read(ctr);
+    cnt = rs.atomic(cnt);
+    smp = rs.storage_write(smp);
+    const ResolvePush rp{center_scale, static_cast<std::uint32_t>(base), count, static_cast<std::uint32_t>(n),
+                         max_samples, cos_half, static_cast<std::uint32_t>(rule), cfg.resolution,
+                         1.0f / static_cast<float>(cfg.resolution), static_cast<std::uint32_t>(node_capacity)};
+    rs.execute([&, rp](PassContext& pc) {
+      vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, resolve.get());
+      vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, resolve.layout.get(), 0, 1, &resolve_set, 0,
+                              nullptr);
+      vkCmdPushConstants(pc.cmd, resolve.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(rp), &rp);
+      vkCmdDispatch(pc.cmd, groups, 1, 1);
+    });
+    const CompiledGraph plan = g.compile();
+    if (base == 0 && log_level() <= LogLevel::Debug)
+      log_debug("fragment-list render graph (first batch):\n" + plan.describe());
+    auto t = execute(*ctx, plan, transients, {.profile = cfg.profile});
+    gpu.insert(gpu.end(), t.begin(), t.end());
+
+    const std::uint32_t appended = *static_cast<const std::uint32_t*>(counter.mapped());
+    if (appended > node_capacity) {
+      // The resolve pass skipped this batch: grow and run it again.
+      dropped += appended - node_capacity;
+      grow_nodes(static_cast<std::size_t>(appended) + appended / 4);
+      write_sets();
+      continue;
+    }
+    base += static_cast<int>(count);
+  }
+  if (dropped > 0)
+    log_warning("the fragment-list node buffer overflowed (" + std::to_string(dropped) +
+                " fragments dropped); it was grown to " + std::to_string(node_capacity) +
+                " nodes and the affected camera batches were run again");
 }
 
 RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu,
@@ -379,6 +576,8 @@ std::string DepthPeelBackend::device_name() const { return impl_->ctx->info().na
 Context& DepthPeelBackend::context() { return *impl_->ctx; }
 const DepthPeelConfig& DepthPeelBackend::config() const { return impl_->cfg; }
 int DepthPeelBackend::last_layer_count() const { return impl_->last_layers; }
+std::size_t DepthPeelBackend::fragment_capacity() const { return impl_->node_capacity; }
+std::size_t DepthPeelBackend::last_dropped_fragments() const { return impl_->dropped; }
 bool DepthPeelBackend::peels_front_layers() const { return impl_->front_layers; }
 std::vector<StageTiming> DepthPeelBackend::last_timings() const { return impl_->timings; }
 std::size_t DepthPeelBackend::device_memory_bytes() const {
@@ -446,8 +645,12 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   bool cap_hit = false;
   m.last_layers = 0;
   int previous_camera_layers = 1;
+  if (m.lists) {
+    m.run_lists(n, max_samples, cos_half, options.false_hit, gpu);
+    m.last_layers = 1;
+  }
 
-  for (int base = 0; base < m.cfg.views; base += m.batch) {
+  for (int base = 0; base < (m.lists ? 0 : m.cfg.views); base += m.batch) {
     const auto count = static_cast<std::uint32_t>(std::min(m.batch, m.cfg.views - base));
     int layer = 1;
     bool more = true;
@@ -566,7 +769,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   if (cap_hit)
     log_warning("depth peeling stopped at max_layers = " + std::to_string(m.cfg.max_layers) +
                 " with fragments still coming; deeper layers were ignored");
-  m.timings.push_back({"peel_and_diameter", ms_since(t0)});
+  m.timings.push_back({m.lists ? "lists_and_resolve" : "peel_and_diameter", ms_since(t0)});
 
   t0 = Clock::now();
   RawSdf out = m.run_gather(n, max_samples, &gpu);

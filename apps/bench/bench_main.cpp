@@ -48,6 +48,8 @@ int main(int argc, char** argv) {
   app.add_option("--rays", o.rays, "Rays per point for the ray backends");
   app.add_option("--views", o.views, "Vulkan views (0 = default)");
   app.add_option("--resolution", o.resolution, "Vulkan resolution (0 = default)");
+  app.add_option("--vulkan-mode", o.vulkan_mode, "Vulkan peel mode: layers (the paper's) | lists (fragment lists)")
+      ->check(CLI::IsMember({"layers", "lists"}));
   app.add_option("--repeats", o.repeats, "Warm repeats per backend");
   app.add_option("--device", o.device, "GPU device selector");
   app.add_flag("--profile", o.profile, "Per-pass GPU timestamps (Vulkan) in the stage table");

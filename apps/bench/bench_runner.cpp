@@ -84,6 +84,7 @@ std::unique_ptr<SdfBackend> make(const std::string& name, const BenchOptions& o,
   c.device = o.device;
   c.views = views;
   c.resolution = resolution;
+  c.vulkan_mode = o.vulkan_mode;
   c.profile = o.profile;
   return make_backend(c);
 }

@@ -25,6 +25,7 @@ struct BenchOptions {
   int rays = 30;             // ray backends' default table
   int cgal_rays = 25;        // the CGAL comparison (per face)
   int views = 0, resolution = 0;  // Vulkan (0 = backend default)
+  std::string vulkan_mode;        // Vulkan: "layers" | "lists" ("" = backend default)
   int meshlab_views = 128, meshlab_resolution = 512;
   int repeats = 3;           // warm calls after the first; the median is reported
   bool cgal = true;

@@ -23,6 +23,9 @@ void add_sdf_options(CLI::App& cmd, SdfCliOptions& o) {
       ->check(CLI::Range(1, 4096));
   cmd.add_option("--resolution", o.backend_config.resolution, "Framebuffer size in pixels (Vulkan)")
       ->check(CLI::Range(16, 8192));
+  cmd.add_option("--peel-mode", o.backend_config.vulkan_mode,
+                 "Vulkan: layers (the paper's depth peeling) | lists (per-pixel fragment lists)")
+      ->check(CLI::IsMember({"layers", "lists"}));
   cmd.add_option("--memory-cap", o.backend_config.memory_cap, "Device memory cap in bytes (OpenCL)");
   cmd.add_option("--accel", o.backend_config.accel, "OpenCL acceleration structure: bvh (default) | octree")
       ->check(CLI::IsMember({"bvh", "octree"}));

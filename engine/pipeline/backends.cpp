@@ -51,6 +51,10 @@ std::unique_ptr<SdfBackend> make_vulkan([[maybe_unused]] const BackendConfig& c)
   config.device = c.device;
   if (c.views > 0) config.views = c.views;
   if (c.resolution > 0) config.resolution = c.resolution;
+  if (c.vulkan_mode == "layers") config.mode = vk::PeelMode::Layers;
+  else if (c.vulkan_mode == "lists") config.mode = vk::PeelMode::FragmentLists;
+  else if (!c.vulkan_mode.empty())
+    throw InputError("unknown Vulkan peel mode '" + c.vulkan_mode + "' (expected layers or lists)");
   config.validation = config.validation || c.validation;
   config.profile = c.profile;
   return std::make_unique<vk::DepthPeelBackend>(config);

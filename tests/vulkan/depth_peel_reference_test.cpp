@@ -22,8 +22,9 @@ namespace {
 
 Mesh load(const std::string& name) { return io::load_asset(test::data_mesh(name)).mesh; }
 
-std::unique_ptr<DepthPeelBackend> make_backend(int views, int resolution) {
+std::unique_ptr<DepthPeelBackend> make_backend(int views, int resolution, PeelMode mode = DepthPeelConfig{}.mode) {
   DepthPeelConfig cfg;
+  cfg.mode = mode;
   cfg.views = views;
   cfg.resolution = resolution;
   cfg.validation = true;
@@ -76,6 +77,38 @@ TEST(DepthPeelReference, RealMeshesMatchEmbree) {
     EXPECT_GE(r, 0.97) << name;
   }
   SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
+}
+
+// The fragment-list mode against the paper's peeling on a CGAL mesh (closed: the same surfaces
+// are found, so the fields agree up to rounding), and both against Embree.
+TEST(DepthPeelReference, FragmentListsAgreeWithLayersOnARealMesh) {
+  auto layers = make_backend(64, 128, PeelMode::Layers);
+  if (!layers) GTEST_SKIP() << "no Vulkan device";
+  auto lists = make_backend(64, 128, PeelMode::FragmentLists);
+  const Mesh m = load("elephant.off");
+  const SdfOptions o;
+  layers->set_mesh(m);
+  lists->set_mesh(m);
+  const SdfField a = compute_sdf(*layers, m, o), b = compute_sdf(*lists, m, o);
+  std::vector<float> va, vb;
+  both_valued(a, b, va, vb);
+  EXPECT_GT(va.size(), m.vertex_count() * 98 / 100);
+  const double mrd = test::median_relative_difference(va, vb), r = test::pearson(va, vb);
+  std::printf("[stats] elephant layers vs lists: median rel %.5f, pearson %.6f\n", mrd, r);
+  EXPECT_LT(mrd, 0.005);
+  EXPECT_GT(r, 0.999);
+  reference::EmbreeBackend ref;
+  ref.set_mesh(m);
+  const SdfField want = compute_sdf(ref, m, o);
+  for (const SdfField* got : {&a, &b}) {
+    std::vector<float> g, w;
+    both_valued(*got, want, g, w);
+    std::printf("[stats] elephant %s vs Embree: median rel %.4f, pearson %.4f\n", got == &a ? "layers" : "lists",
+                test::median_relative_difference(g, w), test::pearson(g, w));
+    EXPECT_LE(test::median_relative_difference(g, w), 0.05);
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(layers->context());
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(lists->context());
 }
 
 TEST(DepthPeelReference, PerFaceMatchesEmbree) {

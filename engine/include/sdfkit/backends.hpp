@@ -22,6 +22,7 @@ struct BackendConfig {
   // Vulkan depth peeling
   int views = 0;                         // 0 = the backend's default
   int resolution = 0;                    // 0 = the backend's default
+  std::string vulkan_mode;               // "layers" | "lists" (fragment lists); "" = default
   bool validation = false;
   bool profile = false;
   // OpenCL ray casting

@@ -1,0 +1,87 @@
+#version 450
+// Fragment-list resolve pass: one invocation per query point, looping over the cameras of the
+// batch. For each camera whose view direction lies within the cone around the point's inward
+// normal, the point's pixel list gives the nearest back face strictly behind the point (the
+// exit) and the nearest front face behind it by more than front_tolerance; the closest hit is
+// the front face when it lies before the exit, else the exit; no exit, no sample. Depths are
+// moved to the point's sub-pixel position as in the diameter pass (corrected_depth). The
+// false-intersection rule and the stored (length, theta) pairs are the diameter pass's.
+#extension GL_GOOGLE_include_directive : require
+#include "fragment_list_common.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(std430, set = 0, binding = 0) readonly buffer Cameras { Camera cams[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Points {
+  vec4 points[];  // per point: ray origin xyz (model units), w = 1 valid / 0 invalid; then inward normals
+};
+layout(std430, set = 0, binding = 2) buffer Counts { uint counts[]; };
+layout(std430, set = 0, binding = 3) writeonly buffer Samples { vec2 samples[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Heads { uint heads[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Nodes { uint nodes[]; };
+layout(std430, set = 0, binding = 6) readonly buffer Counter { uint appended; };
+
+layout(push_constant) uniform Push {
+  vec4 center_scale;    // bounding-sphere centre, 1 / framed radius R
+  uint camera_base;
+  uint camera_count;
+  uint point_count;
+  uint max_samples;
+  float cos_half_cone;
+  uint rule;            // 0 = Paper, 1 = Cgal
+  int resolution;
+  float front_tolerance;  // normalised depth
+  uint capacity;        // nodes
+} pc;
+
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.point_count) return;
+  if (appended > pc.capacity) return;  // overflowed batch: run again by the host
+  const vec4 origin = points[i];
+  if (origin.w == 0.0) return;
+  const vec3 inward = points[pc.point_count + i].xyz;
+  const vec3 q = (origin.xyz - pc.center_scale.xyz) * pc.center_scale.w;  // in units of R
+  const float res = float(pc.resolution);
+
+  for (uint c = 0u; c < pc.camera_count; ++c) {
+    const Camera cam = cams[pc.camera_base + c];
+    const float cos_theta = dot(inward, cam.dir.xyz);
+    if (cos_theta < pc.cos_half_cone) continue;
+    const vec2 ndc = vec2(dot(q, cam.right.xyz), dot(q, cam.up.xyz));
+    const vec2 pos = (ndc * 0.5 + 0.5) * res;  // framebuffer position in pixels
+    const ivec2 px = ivec2(floor(pos));
+    if (any(lessThan(px, ivec2(0))) || any(greaterThanEqual(px, ivec2(pc.resolution)))) continue;
+    const float zp = dot(q, cam.dir.xyz) * 0.5 + 0.5;
+
+    float z_back = kNoSurface, z_front = kNoSurface;
+    vec3 n_back = vec3(0.0), n_front = vec3(0.0);
+    uint node = heads[(c * uint(pc.resolution) + uint(px.y)) * uint(pc.resolution) + uint(px.x)];
+    while (node != kEndOfList) {
+      const uint bits = nodes[kNodeWords * node];
+      const vec3 n = decode_normal(nodes[kNodeWords * node + 1u]);
+      const float z = corrected_depth(uintBitsToFloat(bits & ~kFrontBit), n, px, pos, cam, pc.resolution);
+      if ((bits & kFrontBit) != 0u) {
+        if (z > zp + pc.front_tolerance && z < z_front) {
+          z_front = z;
+          n_front = n;
+        }
+      } else if (z > zp && z < z_back) {
+        z_back = z;
+        n_back = n;
+      }
+      node = nodes[kNodeWords * node + 2u];
+    }
+    if (z_back >= 1.5) continue;  // no exit behind the point
+    const bool front_hit = z_front < z_back;
+    const float z_hit = front_hit ? z_front : z_back;
+    const vec3 hit_normal = front_hit ? n_front : n_back;
+    const bool accepted = pc.rule == 0u ? dot(hit_normal, inward) >= 0.0    // hit . outward start <= 0
+                                        : dot(cam.dir.xyz, hit_normal) > 0.0;
+    if (!accepted) continue;
+    const float length_model = (z_hit - zp) * 2.0 / pc.center_scale.w;
+    const float theta = acos(clamp(cos_theta, -1.0, 1.0));
+    const uint slot = atomicAdd(counts[i], 1u);
+    if (slot < pc.max_samples) samples[i * pc.max_samples + slot] = vec2(length_model, theta);
+  }
+}
