@@ -1,0 +1,114 @@
+#pragma once
+// SDF-driven skeletons (Shapira, Shamir & Cohen-Or 2008, section 5), built on the mesh
+// contraction of Au, Tai, Chu, Cohen-Or & Lee 2008 ("Skeleton extraction by mesh contraction").
+//
+// The road:  closed mesh ──contract()──▶ contracted mesh (same connectivity, near-zero volume)
+//            ──connectivity surgery (half-edge collapses)──▶ curve skeleton
+//            ──embedding refinement, radii from the SDF──▶ nodes
+//            ──visibility check──▶ sheets where a curve is not reliable ──▶ Skeleton.
+//
+// The SDF comes from any SdfBackend (a session: the GPU backends keep their context and
+// buffers). contract() calls backend->set_mesh(mesh) once, then update_positions() and
+// compute_sdf() at every iteration on the current, contracting mesh.
+//
+// Input: a closed (watertight, edge-manifold) triangle mesh. A mesh with boundary edges or
+// non-manifold edges is refused with an InputError. A mesh of several components is contracted
+// as one system (the Laplacian is block-diagonal, the SDF sees all components, as in the plain
+// SDF of that mesh); the skeleton then has one connected part per component.
+
+#include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/sdf.hpp"
+
+#include <array>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace sdfkit::skeleton {
+
+struct ContractionOptions {
+  // Initial contraction weight W_L0 = wl_scale / sqrt(mean face area) with positions measured
+  // in units of the bounding-box diagonal (so the result does not depend on the model's units).
+  // Au et al. print W_L0 = 1e-3 * sqrt(A); with the dimensionless cotangent Laplacian that value
+  // only starts to contract after ~15-20 doublings, see the README of engine/skeleton for the
+  // measurement. The default below starts contracting at once.
+  double wl_scale = 1e-3;
+  double sl = 2.0;   // W_L is multiplied by sl after every iteration (Au: S_L = 2)
+  double wh0 = 1.0;  // initial holding weight W_H0 for every vertex
+  // Weight of the SDF centering term (attraction of v_i to C_i = v_i - SDF_i/2 * n_i).
+  double wc = 0.5;
+  bool sdf_term = true;   // use the centering term and the SDF holding weights (needs a backend)
+  double sdf_bias = 0.01; // W_H_i /= SDFnorm_i * (1 - bias) + bias
+  // Stop when the total one-ring area falls below this fraction of the initial area.
+  double area_ratio_stop = 1e-3;
+  int max_iterations = 20;  // hard cap on the iterations (>= 1)
+  SdfOptions sdf;           // options of the SDF recomputed at every iteration (domain: Vertex)
+};
+
+struct ContractionResult {
+  Mesh contracted;              // same triangles as the input, contracted positions
+  int iterations = 0;           // solves that were accepted
+  std::vector<float> first_sdf; // per-vertex SDF of the input mesh (empty without SDF term)
+  std::vector<float> last_sdf;  // per-vertex SDF of the last contracted mesh that was measured
+  double area_ratio = 1.0;      // total area now / initial total area
+  std::vector<std::string> warnings;
+};
+
+// Contracts `mesh` (closed) by iterated Laplacian smoothing with holding and SDF centering
+// constraints. `backend` may be nullptr: then no SDF term (the plain Au et al. contraction).
+// Never returns NaN positions: a failing factorization or a non-finite solution stops the loop
+// with the last good state and a warning. Throws InputError for unusable input (see top).
+ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& options);
+
+struct SkeletonOptions {
+  double ggt = 0.05;   // grouping: global part of the distance, fraction of the bbox diagonal
+  double gmt = 1.25;   // grouping: multiple of the local radius SDF_i/2
+  bool sheets = true;  // keep unreliable regions as triangle sheets
+  double shape_weight = 1.0;     // Au's w_a: weight of the quadric shape cost
+  double sampling_weight = 0.1;  // Au's w_b: weight of the sampling cost
+  bool refine_embedding = true;  // move nodes toward the centre of their surface region
+};
+
+struct Node {
+  glm::vec3 position{0.0f};
+  float radius = 0.0f;                  // local radius in model units (SDF/2 of its vertices)
+  std::vector<std::uint32_t> vertices;  // input-mesh vertices this node represents
+  bool sheet = false;                   // node of a sheet (one contracted vertex)
+};
+
+struct Skeleton {
+  std::vector<Node> nodes;
+  std::vector<std::array<std::uint32_t, 2>> edges;  // curve edges, indices into nodes, i < j
+  std::vector<Triangle> sheet_triangles;            // sheet patches, indices into nodes
+  // Share of surface vertices whose node is visible from them along a segment inside the solid.
+  double reliability = 0.0;
+  double curve_reliability = 0.0;  // the same for the curve skeleton before sheets were added
+  int iterations = 0;              // contraction iterations
+  std::vector<std::string> warnings;
+};
+
+// Contraction + connectivity surgery + refinement + sheets. `backend` may be nullptr (no SDF:
+// radii are the mean distance from a node to its vertices; grouping uses that radius).
+// Every input vertex belongs to exactly one node.
+Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
+                 const SkeletonOptions& options);
+
+// Builds the skeleton of an already contracted mesh (the second half of extract()):
+// `original` the input, `contracted` the output of contract() (same triangles), `sdf` the
+// per-vertex SDF of the original (may be empty).
+Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+                        const SkeletonOptions& options);
+
+// {"nodes":[{"position":[x,y,z],"radius":r,"sheet":false,"vertices":[...]}...],
+//  "edges":[[i,j]...], "sheet_triangles":[[i,j,k]...], "reliability":..., "iterations":...,
+//  "warnings":[...]}
+std::string to_json(const Skeleton& skeleton);
+
+// Wavefront OBJ: one `v` per node, `l` per edge, `f` per sheet triangle (1-based).
+void write_obj(std::ostream& out, const Skeleton& skeleton);
+
+// Cycles of the skeleton graph (curve edges and sheet triangle edges): E - V + components.
+int cycle_count(const Skeleton& skeleton);
+
+}  // namespace sdfkit::skeleton

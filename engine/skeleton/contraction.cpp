@@ -1,0 +1,143 @@
+// Mesh contraction (Au et al. 2008) with the SDF centering term and SDF holding weights
+// (Shapira et al. 2008, section 5).
+
+#include "sdfkit/skeleton/skeleton.hpp"
+
+#include "laplacian.hpp"
+#include "validate.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace sdfkit::skeleton {
+namespace {
+
+// Holding weights grow as sqrt(A0 / At); the growth is capped so that a fully collapsed
+// one-ring (At -> 0) stays a finite, well-conditioned constraint.
+constexpr double kMaxHoldingGrowth = 1e4;
+
+void validate(const ContractionOptions& o) {
+  auto bad = [](const std::string& what) { throw InputError("contraction option " + what); };
+  if (!(o.wl_scale > 0.0) || !std::isfinite(o.wl_scale)) bad("wl_scale must be positive");
+  if (!(o.sl >= 1.0) || !std::isfinite(o.sl)) bad("sl (contraction growth) must be at least 1");
+  if (!(o.wh0 > 0.0) || !std::isfinite(o.wh0)) bad("wh0 (holding weight) must be positive");
+  if (!(o.wc >= 0.0) || !std::isfinite(o.wc)) bad("wc (SDF centering weight) must be >= 0");
+  if (!(o.sdf_bias > 0.0 && o.sdf_bias <= 1.0)) bad("sdf_bias must be in (0, 1]");
+  if (!(o.area_ratio_stop >= 0.0 && o.area_ratio_stop < 1.0)) bad("area_ratio_stop must be in [0, 1)");
+  if (o.max_iterations < 1 || o.max_iterations > 1000) bad("max_iterations must be in [1, 1000]");
+  validate_options(o.sdf);
+}
+
+double total(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
+
+bool all_finite(const Eigen::MatrixXd& m) { return m.allFinite(); }
+
+}  // namespace
+
+ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& options) {
+  validate(options);
+  detail::require_closed(mesh, "skeleton extraction");
+  ContractionResult result;
+  result.contracted = mesh;
+  const bool use_sdf = options.sdf_term && backend != nullptr;
+  SdfOptions sdf_options = options.sdf;
+  sdf_options.domain = SdfDomain::Vertex;
+
+  const std::size_t n = mesh.positions.size();
+  const double diag = bounding_box(mesh.positions).diagonal();
+  const std::vector<double> area0 = detail::one_ring_areas(mesh);
+  const double total0 = total(area0);
+  const double mean_face_area = total0 / 3.0 / static_cast<double>(mesh.triangles.size());
+  // Dimensionless W_L0 (see the header): the mean face area measured in diag^2.
+  double wl = options.wl_scale / std::sqrt(mean_face_area / (diag * diag));
+  std::vector<double> wh(n, options.wh0);
+
+  if (use_sdf) backend->set_mesh(mesh);
+  Eigen::MatrixXd V(static_cast<Eigen::Index>(n), 3);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) V(static_cast<Eigen::Index>(i), k) = mesh.positions[i][k];
+
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    Mesh& current = result.contracted;
+    Eigen::MatrixXd C;
+    if (use_sdf) {
+      if (it > 0) backend->update_positions(current.positions);
+      const SdfField field = compute_sdf(*backend, current, sdf_options);
+      if (it == 0) result.first_sdf = field.values;
+      result.last_sdf = field.values;
+      const std::vector<glm::vec3> normals = vertex_normals(current);
+      C = V;
+      for (std::size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k)
+          C(static_cast<Eigen::Index>(i), k) -= 0.5 * field.values[i] * normals[i][k];
+      if (it > 0) {
+        const std::vector<float> norm = normalized(field.values);
+        for (std::size_t i = 0; i < n; ++i)
+          wh[i] /= norm[i] * (1.0 - options.sdf_bias) + options.sdf_bias;
+      }
+    }
+
+    const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(current);
+    Eigen::SparseMatrix<double> A = (wl * wl) * (L * L);  // L is symmetric: L^T L = L L
+    Eigen::VectorXd diagonal(static_cast<Eigen::Index>(n));
+    Eigen::MatrixXd rhs(static_cast<Eigen::Index>(n), 3);
+    const double wc2 = use_sdf ? options.wc * options.wc : 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      const double wh2 = wh[i] * wh[i];
+      diagonal(r) = wh2 + wc2;
+      rhs.row(r) = wh2 * V.row(r);
+      if (use_sdf) rhs.row(r) += wc2 * C.row(r);
+    }
+    for (Eigen::Index r = 0; r < A.outerSize(); ++r) A.coeffRef(r, r) += diagonal(r);
+
+    solver.compute(A);
+    if (solver.info() != Eigen::Success) {
+      result.warnings.push_back("contraction stopped after " + std::to_string(it) +
+                                " iterations: the sparse factorization failed; the last good "
+                                "state is kept");
+      break;
+    }
+    const Eigen::MatrixXd next = solver.solve(rhs);
+    if (solver.info() != Eigen::Success || !all_finite(next)) {
+      result.warnings.push_back("contraction stopped after " + std::to_string(it) +
+                                " iterations: the solve gave non-finite positions; the last "
+                                "good state is kept");
+      break;
+    }
+    V = next;
+    for (std::size_t i = 0; i < n; ++i)
+      current.positions[i] = glm::vec3(V(static_cast<Eigen::Index>(i), 0),
+                                       V(static_cast<Eigen::Index>(i), 1),
+                                       V(static_cast<Eigen::Index>(i), 2));
+    result.iterations = it + 1;
+
+    const std::vector<double> area = detail::one_ring_areas(current);
+    result.area_ratio = total0 > 0.0 ? total(area) / total0 : 0.0;
+    log_debug("contraction iteration " + std::to_string(it + 1) + ": area ratio " +
+              std::to_string(result.area_ratio));
+    if (result.area_ratio < options.area_ratio_stop) break;
+
+    wl *= options.sl;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double growth = area[i] > 0.0 ? std::sqrt(area0[i] / area[i]) : kMaxHoldingGrowth;
+      wh[i] = options.wh0 * std::min(growth, kMaxHoldingGrowth);
+    }
+  }
+  if (result.iterations == options.max_iterations && result.area_ratio >= options.area_ratio_stop)
+    result.warnings.push_back("contraction reached the iteration cap (" +
+                              std::to_string(options.max_iterations) + ") at area ratio " +
+                              std::to_string(result.area_ratio));
+  for (const std::string& w : result.warnings) log_warning(w);
+  return result;
+}
+
+}  // namespace sdfkit::skeleton

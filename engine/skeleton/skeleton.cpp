@@ -1,0 +1,255 @@
+// From a contracted mesh to a skeleton: surgery, embedding refinement, radii, reliability and
+// sheets (Shapira et al. 2008, section 5; Au et al. 2008, sections 4-5).
+
+#include "sdfkit/skeleton/skeleton.hpp"
+
+#include "bvh.hpp"
+#include "laplacian.hpp"
+#include "surgery.hpp"
+#include "validate.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+#include "sdfkit/core/topology.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+namespace sdfkit::skeleton {
+namespace {
+
+// Rounds of "move the vertices that cannot see their node into the sheet, re-centre the curve
+// nodes that lost vertices, check again" before the remaining failures go to the sheet at once.
+constexpr int kSheetRounds = 8;
+
+// Everything about the input surface that node placement and visibility need.
+struct Surface {
+  const Mesh& original;
+  const Mesh& contracted;
+  detail::TriangleBvh bvh;
+  std::vector<glm::vec3> normals;  // outward vertex normals
+  std::vector<double> weight;      // one-ring areas (refinement weights)
+  std::vector<glm::vec3> centre;   // per vertex: a point inside the solid seen from the vertex
+  std::vector<float> sdf;          // per vertex SDF of the original (may be empty)
+
+  Surface(const Mesh& o, const Mesh& c, const std::vector<float>& s)
+      : original(o), contracted(c), bvh(o), normals(vertex_normals(o)),
+        weight(detail::one_ring_areas(o)), sdf(s) {
+    centre.resize(o.positions.size());
+    const float far = 2.0f * bounding_box(o.positions).diagonal();
+    for (std::uint32_t k = 0; k < o.positions.size(); ++k) {
+      // Half way along the inward normal to the first surface it meets: inside, and visible.
+      const glm::vec3 u = o.positions[k], n = normals[k];
+      const auto hit = bvh.closest(u, -n, 0.0f, far, k);
+      const float depth = hit.found ? hit.t : (sdf.empty() ? 0.0f : sdf[k]);
+      centre[k] = u - 0.5f * depth * n;
+    }
+  }
+
+  bool sees(std::uint32_t k, const glm::vec3& p) const {
+    return !bvh.segment_blocked(original.positions[k], p, k);
+  }
+
+  // A node's position from its contracted position: moved by the area-weighted mean of its
+  // vertices' offsets (original - contracted), i.e. toward the centre of the surface region it
+  // represents (Au et al.'s embedding refinement), kept only when that stays inside the solid.
+  // If neither is inside, the mean of the vertices' centre points, then the centre point of the
+  // closest vertex (inside by construction).
+  glm::vec3 place(const glm::vec3& contracted_position, const std::vector<std::uint32_t>& members,
+                  bool refine) const {
+    std::vector<glm::vec3> candidates;
+    if (refine) {
+      glm::dvec3 offset(0.0);
+      double total = 0.0;
+      for (std::uint32_t k : members) {
+        offset += weight[k] * glm::dvec3(original.positions[k] - contracted.positions[k]);
+        total += weight[k];
+      }
+      if (total > 0.0) candidates.push_back(contracted_position + glm::vec3(offset / total));
+    }
+    candidates.push_back(contracted_position);
+    glm::dvec3 mean(0.0);
+    for (std::uint32_t k : members) mean += glm::dvec3(centre[k]);
+    candidates.push_back(glm::vec3(mean / static_cast<double>(members.size())));
+    for (const glm::vec3& c : candidates)
+      if (bvh.inside(c)) return c;
+    std::uint32_t best = members.front();
+    float best_d = std::numeric_limits<float>::max();
+    for (std::uint32_t k : members) {
+      const float d = glm::length(original.positions[k] - contracted_position);
+      if (d < best_d) best_d = d, best = k;
+    }
+    return centre[best];
+  }
+
+  // A node's radius: the mean SDF/2 of its vertices, or without an SDF the mean distance from
+  // the node to them.
+  float radius(const glm::vec3& p, const std::vector<std::uint32_t>& members) const {
+    double s = 0.0;
+    for (std::uint32_t k : members)
+      s += sdf.empty() ? glm::length(original.positions[k] - p) : 0.5 * sdf[k];
+    return static_cast<float>(s / static_cast<double>(members.size()));
+  }
+};
+
+void validate(const SkeletonOptions& o) {
+  if (!(o.ggt >= 0.0 && o.ggt < 1.0)) throw InputError("skeleton option ggt must be in [0, 1)");
+  if (!(o.gmt >= 0.0 && o.gmt < 100.0)) throw InputError("skeleton option gmt must be in [0, 100)");
+  if (!(o.shape_weight >= 0.0) || !(o.sampling_weight >= 0.0) ||
+      o.shape_weight + o.sampling_weight <= 0.0)
+    throw InputError("skeleton collapse cost weights must be >= 0 and not both 0");
+}
+
+}  // namespace
+
+Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+                        const SkeletonOptions& options) {
+  validate(options);
+  detail::require_closed(original, "skeleton extraction");
+  const std::size_t n = original.positions.size();
+  if (contracted.positions.size() != n || contracted.triangles != original.triangles)
+    throw InputError("the contracted mesh does not match the original's connectivity");
+  if (!sdf.empty() && sdf.size() != n)
+    throw InputError("the SDF has " + std::to_string(sdf.size()) + " values for " +
+                     std::to_string(n) + " vertices");
+
+  const double diag = bounding_box(original.positions).diagonal();
+  std::vector<float> local_radius(n);
+  for (std::size_t k = 0; k < n; ++k)
+    local_radius[k] = sdf.empty() ? glm::length(original.positions[k] - contracted.positions[k])
+                                  : 0.5f * sdf[k];
+  detail::SurgeryOptions so;
+  so.shape_weight = options.shape_weight;
+  so.sampling_weight = options.sampling_weight;
+  so.grouping_global = options.ggt * diag;
+  so.grouping_local = options.gmt;
+  const detail::CurveGraph graph = detail::collapse_to_curves(contracted, local_radius, so);
+
+  const Surface surface(original, contracted, sdf);
+  const std::size_t curve_nodes = graph.positions.size();
+  std::vector<std::uint32_t> owner(n);
+  for (std::uint32_t c = 0; c < curve_nodes; ++c)
+    for (std::uint32_t k : graph.members[c]) owner[k] = c;
+
+  std::vector<std::vector<std::uint32_t>> members = graph.members;
+  std::vector<glm::vec3> position(curve_nodes);
+  for (std::uint32_t c = 0; c < curve_nodes; ++c)
+    position[c] = surface.place(graph.positions[c], members[c], options.refine_embedding);
+
+  auto failing_vertices = [&](const std::vector<std::uint8_t>& in_sheet) {
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t k = 0; k < n; ++k)
+      if (!in_sheet[k] && !surface.sees(k, position[owner[k]])) out.push_back(k);
+    return out;
+  };
+
+  Skeleton sk;
+  std::vector<std::uint8_t> in_sheet(n, 0);
+  std::vector<std::uint32_t> failing = failing_vertices(in_sheet);
+  sk.curve_reliability = 1.0 - static_cast<double>(failing.size()) / static_cast<double>(n);
+
+  if (options.sheets && !failing.empty()) {
+    const Adjacency ring = vertex_adjacency(original);
+    for (int round = 0; !failing.empty(); ++round) {
+      for (std::uint32_t k : failing) {
+        in_sheet[k] = 1;
+        if (round < kSheetRounds)
+          for (std::uint32_t e = ring.offsets[k]; e < ring.offsets[k + 1]; ++e)
+            in_sheet[ring.indices[e]] = 1;
+      }
+      // Curve nodes that lost vertices are placed again from the vertices they keep.
+      for (std::uint32_t c = 0; c < curve_nodes; ++c) {
+        const std::size_t before = members[c].size();
+        std::erase_if(members[c], [&](std::uint32_t k) { return in_sheet[k] != 0; });
+        if (!members[c].empty() && members[c].size() != before)
+          position[c] = surface.place(graph.positions[c], members[c], options.refine_embedding);
+      }
+      failing = round < kSheetRounds ? failing_vertices(in_sheet) : std::vector<std::uint32_t>{};
+    }
+  }
+
+  // Curve nodes that still represent vertices, in order, then one sheet node per sheet vertex.
+  std::vector<std::uint32_t> node_of_curve(curve_nodes, UINT32_MAX);
+  for (std::uint32_t c = 0; c < curve_nodes; ++c) {
+    if (members[c].empty()) continue;
+    node_of_curve[c] = static_cast<std::uint32_t>(sk.nodes.size());
+    Node node;
+    node.position = position[c];
+    node.vertices = members[c];
+    node.radius = surface.radius(node.position, node.vertices);
+    sk.nodes.push_back(std::move(node));
+  }
+  std::vector<std::uint32_t> node_of_vertex(n, UINT32_MAX);
+  for (std::uint32_t k = 0; k < n; ++k) {
+    if (in_sheet[k]) {
+      Node node;
+      node.sheet = true;
+      node.vertices = {k};
+      const glm::vec3 v = contracted.positions[k];
+      node.position = surface.bvh.inside(v) && surface.sees(k, v) ? v : surface.centre[k];
+      node.radius = surface.radius(node.position, node.vertices);
+      node_of_vertex[k] = static_cast<std::uint32_t>(sk.nodes.size());
+      sk.nodes.push_back(std::move(node));
+    } else {
+      node_of_vertex[k] = node_of_curve[owner[k]];
+    }
+  }
+
+  std::set<std::array<std::uint32_t, 2>> edges;
+  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
+    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
+  };
+  for (const auto& e : graph.edges) add_edge(node_of_curve[e[0]], node_of_curve[e[1]]);
+  for (const Triangle& t : original.triangles) {
+    const bool s0 = in_sheet[t[0]], s1 = in_sheet[t[1]], s2 = in_sheet[t[2]];
+    if (s0 && s1 && s2) {
+      sk.sheet_triangles.push_back({node_of_vertex[t[0]], node_of_vertex[t[1]], node_of_vertex[t[2]]});
+      continue;
+    }
+    // Where the sheet meets a curve, connect the two through the mesh's edges.
+    for (int i = 0; i < 3; ++i) {
+      const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+      if (in_sheet[a] != in_sheet[b]) add_edge(node_of_vertex[a], node_of_vertex[b]);
+    }
+  }
+  // Sheet-triangle edges are part of the sheet, not curve edges.
+  std::set<std::array<std::uint32_t, 2>> sheet_edges;
+  for (const Triangle& t : sk.sheet_triangles)
+    for (int i = 0; i < 3; ++i)
+      sheet_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+  for (const auto& e : edges)
+    if (!sheet_edges.count(e)) sk.edges.push_back(e);
+
+  std::size_t seen = 0;
+  for (std::uint32_t k = 0; k < n; ++k) seen += surface.sees(k, sk.nodes[node_of_vertex[k]].position);
+  sk.reliability = static_cast<double>(seen) / static_cast<double>(n);
+  if (sk.reliability < 1.0)
+    sk.warnings.push_back(std::to_string(n - seen) + " of " + std::to_string(n) +
+                          " surface vertices cannot see their skeleton node" +
+                          (options.sheets ? "" : " (sheets are off)"));
+  return sk;
+}
+
+Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
+                 const SkeletonOptions& options) {
+  validate(options);
+  ContractionResult c = contract(mesh, backend, contraction);
+  std::vector<float> sdf = std::move(c.first_sdf);
+  if (backend != nullptr && sdf.empty()) {
+    SdfOptions so = contraction.sdf;
+    so.domain = SdfDomain::Vertex;
+    backend->set_mesh(mesh);
+    sdf = compute_sdf(*backend, mesh, so).values;
+  }
+  Skeleton sk = build_skeleton(mesh, c.contracted, sdf, options);
+  sk.iterations = c.iterations;
+  sk.warnings.insert(sk.warnings.begin(), c.warnings.begin(), c.warnings.end());
+  return sk;
+}
+
+}  // namespace sdfkit::skeleton
