@@ -1,0 +1,98 @@
+#pragma once
+// Mesh files in and SDF fields out. Loading keeps every input vertex in input order (what the
+// writers must reproduce) next to the welded Mesh the backends see; writing puts a field back
+// into the input's own vertex order (or face order) in glTF/glb, PLY or plain text.
+//
+// Every problem with an input file is an InputError whose message is one line:
+// "<path>: <problem>".
+
+#include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/sdf.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sdfkit::io {
+
+enum class Format { Gltf, Glb, Obj, Off, Ply, Txt };
+
+// The format named by the path's extension, case-insensitive (.gltf, .glb, .obj, .off, .ply,
+// .txt). Throws InputError "<path>: unknown extension '.xyz' (expected .gltf, .glb, .obj, .off,
+// .ply)" otherwise. .txt is an output-only format: load_asset rejects it.
+Format format_from_path(const std::string& path);
+
+// Lower-case name of a format ("gltf", "off", ...).
+const char* format_name(Format format);
+
+struct LoadOptions {
+  // Positions closer than this (model units, after glTF node transforms) become one welded
+  // vertex; 0 welds bitwise-equal positions only. See sdfkit::weld.
+  float weld_tolerance = 0.0f;
+};
+
+struct Asset {
+  std::string path;
+  Format format = Format::Off;
+  // Every input vertex in world space (glTF: node transforms applied), in input order. For glTF:
+  // the primitives of the scene in traversal order (depth first, children in order), each
+  // primitive's vertex range concatenated; a mesh used by several nodes appears once per node.
+  std::vector<glm::vec3> input_positions;
+  // Triangles as indices into input_positions, in input order (polygons fan-triangulated,
+  // strips and fans unrolled).
+  std::vector<Triangle> input_triangles;
+  // The welded mesh the backends see: same triangle count and order as input_triangles.
+  Mesh mesh;
+  // For each input vertex, its welded vertex in `mesh`.
+  std::vector<std::uint32_t> input_to_welded;
+  // Things skipped or changed while loading ("skipped 2 LINES primitives"), also logged.
+  std::vector<std::string> warnings;
+  // Format-specific data the writers need to write the input back (for glTF: the parsed model
+  // and the vertex range of each primitive instance); nullptr where not needed.
+  std::shared_ptr<const void> source;
+};
+
+// Loads a mesh file (format by extension). Throws InputError with one line "<path>: <problem>"
+// for a missing or unreadable file, a malformed or truncated file, indices out of range,
+// non-finite coordinates or a file without any triangle.
+Asset load_asset(const std::string& path, const LoadOptions& options = {});
+
+struct WriteOptions {
+  bool color = true;        // glTF COLOR_0, PLY red/green/blue from colormap(normalized value)
+  bool normalized = false;  // .txt and PLY quality hold the [0,1] normalized value
+};
+
+// Writes `field` (computed on asset.mesh) to out_path; the format follows the extension:
+//  - .gltf/.glb: per-vertex fields only. A glTF input is written back whole (materials,
+//    textures, other attributes, extensions, node hierarchy) with, on every triangle primitive,
+//    the attributes _SDF (FLOAT SCALAR, model units), _SDF_NORMALIZED ([0,1]) and, with
+//    options.color, COLOR_0 (VEC3 float; an existing COLOR_0 is replaced, with a warning). A
+//    mesh instanced by several nodes stores the values of its first instance. Other inputs get
+//    a fresh minimal glTF: one mesh, one node, one buffer. A .gltf output embeds its buffers
+//    as base64 data URIs, so it is one self-contained file.
+//  - .ply: binary little endian, the input vertices and triangles, `float quality` on vertices
+//    (per-vertex field) or faces (per-face field), with options.color uchar red/green/blue.
+//  - .txt: one value per line (%.9g), input vertex order or face order.
+// The file is written atomically (write_file_atomically). Throws InputError for a field that
+// does not fit the asset or a per-face field to glTF, Error for an I/O failure.
+void write_field(const std::string& out_path, const Asset& asset, const SdfField& field,
+                 const WriteOptions& options = {});
+
+// The colour map of every sdfkit output: t in [0,1] (clamped; NaN counts as 0) to linear RGB in
+// [0,1]. A hue ramp at full saturation, as in the paper's figures: 0 = red (thin), 0.25 =
+// yellow, 0.5 = green, 0.75 = cyan, 1 = blue (thick), linear in hue between those stops.
+glm::vec3 colormap(float t);
+
+// Runs `write` on a stream to a temporary file next to `path` ("<path>.tmp-XXXXXX"), flushes
+// it and renames it over `path`. If `write` throws or any I/O step fails, the temporary file
+// is removed, an existing file at `path` is untouched and the exception propagates (I/O
+// failures as Error "<path>: <problem>").
+void write_file_atomically(const std::string& path,
+                           const std::function<void(std::ostream&)>& write);
+
+}  // namespace sdfkit::io

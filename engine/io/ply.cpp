@@ -1,0 +1,333 @@
+// PLY reader: ascii, binary_little_endian and binary_big_endian. Vertex x, y, z of any numeric
+// type; faces from the list property `vertex_indices` (or `vertex_index`) with any count and
+// index types, polygons fan-triangulated; every other element and property is read past.
+
+#include "readers.hpp"
+#include "text_cursor.hpp"
+
+#include <bit>
+#include <cstring>
+#include <optional>
+#include <vector>
+
+namespace sdfkit::io::detail {
+namespace {
+
+enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+enum class PlyEncoding { Ascii, BinaryLittle, BinaryBig };
+
+struct PlyProperty {
+  std::string name;
+  bool is_list = false;
+  PlyType count_type = PlyType::UInt8;  // lists only
+  PlyType type = PlyType::Float32;      // the scalar, or the list's items
+};
+
+struct PlyElement {
+  std::string name;
+  std::int64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  PlyEncoding encoding = PlyEncoding::Ascii;
+  std::vector<PlyElement> elements;
+  std::size_t data_start = 0;  // first byte after "end_header\n"
+};
+
+std::size_t type_size(PlyType t) {
+  switch (t) {
+    case PlyType::Int8:
+    case PlyType::UInt8: return 1;
+    case PlyType::Int16:
+    case PlyType::UInt16: return 2;
+    case PlyType::Int32:
+    case PlyType::UInt32:
+    case PlyType::Float32: return 4;
+    case PlyType::Float64: return 8;
+  }
+  return 0;
+}
+
+bool is_integral(PlyType t) { return t != PlyType::Float32 && t != PlyType::Float64; }
+
+std::optional<PlyType> parse_type(std::string_view s) {
+  if (s == "char" || s == "int8") return PlyType::Int8;
+  if (s == "uchar" || s == "uint8") return PlyType::UInt8;
+  if (s == "short" || s == "int16") return PlyType::Int16;
+  if (s == "ushort" || s == "uint16") return PlyType::UInt16;
+  if (s == "int" || s == "int32") return PlyType::Int32;
+  if (s == "uint" || s == "uint32") return PlyType::UInt32;
+  if (s == "float" || s == "float32") return PlyType::Float32;
+  if (s == "double" || s == "float64") return PlyType::Float64;
+  return std::nullopt;
+}
+
+PlyType read_type(TextCursor& c) {
+  const std::string_view w = c.word();
+  const std::optional<PlyType> t = parse_type(w);
+  if (!t) c.error("unknown property type '" + TextCursor::printable(w) + "'");
+  return *t;
+}
+
+PlyHeader parse_header(const std::string& path, std::string_view data) {
+  TextCursor c(data, path);
+  if (c.word() != "ply" || !c.at_line_end()) fail(path, "not a PLY file (it does not start with 'ply')");
+  c.next_line();
+  PlyHeader h;
+  bool have_format = false;
+  while (true) {
+    if (c.at_end()) fail(path, "the PLY header has no 'end_header' line");
+    if (c.at_line_end()) {
+      c.next_line();
+      continue;
+    }
+    const std::string_view key = c.word();
+    if (key == "format") {
+      const std::string_view enc = c.word();
+      if (enc == "ascii") h.encoding = PlyEncoding::Ascii;
+      else if (enc == "binary_little_endian") h.encoding = PlyEncoding::BinaryLittle;
+      else if (enc == "binary_big_endian") h.encoding = PlyEncoding::BinaryBig;
+      else c.error("unknown PLY format '" + TextCursor::printable(enc) + "'");
+      have_format = true;
+    } else if (key == "comment" || key == "obj_info") {
+      // ignored
+    } else if (key == "element") {
+      PlyElement e;
+      e.name = std::string(c.word());
+      if (e.name.empty()) c.error("an element without a name");
+      if (!c.try_int(e.count) || e.count < 0) c.expected("the element count of '" + e.name + "'");
+      h.elements.push_back(std::move(e));
+    } else if (key == "property") {
+      if (h.elements.empty()) c.error("a property before any element");
+      PlyProperty p;
+      if (c.peek_word() == "list") {
+        c.word();
+        p.is_list = true;
+        p.count_type = read_type(c);
+        p.type = read_type(c);
+      } else {
+        p.type = read_type(c);
+      }
+      p.name = std::string(c.word());
+      if (p.name.empty()) c.error("a property without a name");
+      h.elements.back().properties.push_back(std::move(p));
+    } else if (key == "end_header") {
+      c.next_line();
+      h.data_start = c.position();
+      break;
+    } else {
+      c.error("unknown PLY header line '" + TextCursor::printable(key) + "'");
+    }
+    c.next_line();
+  }
+  if (!have_format) fail(path, "the PLY header has no 'format' line");
+  return h;
+}
+
+// Smallest number of bytes one row of the element can take in the file.
+double min_row_bytes(const PlyElement& e, PlyEncoding enc) {
+  double bytes = 0.0;
+  for (const PlyProperty& p : e.properties) {
+    if (enc == PlyEncoding::Ascii) bytes += 2.0;  // one digit and a separator
+    else bytes += static_cast<double>(type_size(p.is_list ? p.count_type : p.type));
+  }
+  return bytes;
+}
+
+// Reads binary values of either byte order.
+class BinaryCursor {
+public:
+  BinaryCursor(const std::string& path, std::string_view data, std::size_t start, bool swap)
+      : path_(path), data_(data), pos_(start), swap_(swap) {}
+
+  double scalar(PlyType t) {
+    switch (t) {
+      case PlyType::Int8: return static_cast<double>(raw<std::int8_t>());
+      case PlyType::UInt8: return static_cast<double>(raw<std::uint8_t>());
+      case PlyType::Int16: return static_cast<double>(raw<std::int16_t>());
+      case PlyType::UInt16: return static_cast<double>(raw<std::uint16_t>());
+      case PlyType::Int32: return static_cast<double>(raw<std::int32_t>());
+      case PlyType::UInt32: return static_cast<double>(raw<std::uint32_t>());
+      case PlyType::Float32: return static_cast<double>(raw<float>());
+      case PlyType::Float64: return raw<double>();
+    }
+    return 0.0;
+  }
+
+  void skip(std::size_t bytes, const std::string& what) {
+    if (bytes > data_.size() - pos_) truncated(what);
+    pos_ += bytes;
+  }
+
+  void set_context(const std::string* what) { what_ = what; }
+
+  [[noreturn]] void truncated(const std::string& what) const {
+    fail(path_, "unexpected end of file while reading " + what);
+  }
+
+private:
+  template <typename T>
+  T raw() {
+    if (sizeof(T) > data_.size() - pos_) truncated(what_ ? *what_ : std::string("the data"));
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    if (swap_) {
+      for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(bytes[i], bytes[sizeof(T) - 1 - i]);
+    }
+    T value;
+    std::memcpy(&value, bytes, sizeof(T));
+    return value;
+  }
+
+  const std::string& path_;
+  std::string_view data_;
+  std::size_t pos_;
+  bool swap_;
+  const std::string* what_ = nullptr;
+};
+
+// One element reader for both encodings: `Source` provides scalar(type) (and skip for binary).
+struct AsciiSource {
+  TextCursor& c;
+  const std::string& what;
+  double scalar(PlyType t) {
+    c.skip_blank(false);
+    if (is_integral(t)) {
+      std::int64_t v = 0;
+      if (!c.try_int(v)) c.expected("an integer in " + what);
+      return static_cast<double>(v);
+    }
+    float v = 0.0f;
+    if (!c.try_float(v)) c.expected("a number in " + what);
+    return static_cast<double>(v);
+  }
+  void skip_scalar(PlyType) {
+    c.skip_blank(false);
+    if (c.word().empty()) c.expected("a value in " + what);
+  }
+};
+
+struct BinarySource {
+  BinaryCursor& b;
+  const std::string& what;
+  double scalar(PlyType t) { return b.scalar(t); }
+  void skip_scalar(PlyType t) { b.skip(type_size(t), what); }
+};
+
+}  // namespace
+
+namespace {
+
+template <typename Source>
+void read_elements(const std::string& path, const PlyHeader& h, std::int64_t vertex_count,
+                   std::size_t data_bytes, Source make_source, RawMesh& out) {
+  std::vector<std::uint32_t> corners;
+  std::size_t skipped_faces = 0;
+  for (const PlyElement& e : h.elements) {
+    const bool is_vertex = e.name == "vertex";
+    const bool is_face = e.name == "face";
+    int xyz[3] = {-1, -1, -1};
+    int face_list = -1;
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const PlyProperty& p = e.properties[i];
+      if (is_vertex && !p.is_list) {
+        if (p.name == "x") xyz[0] = static_cast<int>(i);
+        if (p.name == "y") xyz[1] = static_cast<int>(i);
+        if (p.name == "z") xyz[2] = static_cast<int>(i);
+      }
+      if (is_face && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"))
+        face_list = static_cast<int>(i);
+    }
+    if (is_vertex && (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0))
+      fail(path, "the vertex element has no x, y and z properties");
+    if (is_face && face_list < 0)
+      fail(path, "the face element has no list property 'vertex_indices'");
+    if (is_vertex) out.positions.resize(static_cast<std::size_t>(e.count));
+    if (is_face)
+      out.triangles.reserve(std::min(static_cast<std::size_t>(e.count), data_bytes / 4 + 1));
+
+    const std::string what = "element '" + e.name + "'";
+    auto src = make_source(what);
+    for (std::int64_t row = 0; row < e.count; ++row) {
+      for (std::size_t i = 0; i < e.properties.size(); ++i) {
+        const PlyProperty& p = e.properties[i];
+        if (!p.is_list) {
+          if (is_vertex && (static_cast<int>(i) == xyz[0] || static_cast<int>(i) == xyz[1] ||
+                            static_cast<int>(i) == xyz[2])) {
+            const int axis = static_cast<int>(i) == xyz[0] ? 0 : static_cast<int>(i) == xyz[1] ? 1 : 2;
+            out.positions[static_cast<std::size_t>(row)][axis] = static_cast<float>(src.scalar(p.type));
+          } else {
+            src.skip_scalar(p.type);
+          }
+          continue;
+        }
+        const double count_value = src.scalar(p.count_type);
+        if (!(count_value >= 0.0) || count_value > static_cast<double>(data_bytes))
+          fail(path, what + " row " + std::to_string(row) + " has an impossible list length");
+        const auto n = static_cast<std::size_t>(count_value);
+        if (static_cast<int>(i) != face_list) {
+          for (std::size_t k = 0; k < n; ++k) src.skip_scalar(p.type);
+          continue;
+        }
+        corners.resize(n);
+        for (std::size_t k = 0; k < n; ++k) {
+          const double index = src.scalar(p.type);
+          if (!(index >= 0.0) || index >= static_cast<double>(vertex_count) ||
+              index != static_cast<double>(static_cast<std::int64_t>(index)))
+            fail(path, "face " + std::to_string(row) + " uses vertex " +
+                           std::to_string(static_cast<long long>(index)) + " but the file has " +
+                           std::to_string(vertex_count) + " vertices");
+          corners[k] = static_cast<std::uint32_t>(index);
+        }
+        if (n < 3) ++skipped_faces;
+        append_fan(out.triangles, corners.data(), corners.size());
+      }
+    }
+  }
+  if (skipped_faces > 0)
+    out.warnings.push_back("skipped " + std::to_string(skipped_faces) +
+                           " faces with fewer than 3 vertices");
+}
+
+}  // namespace
+
+RawMesh read_ply(const std::string& path, std::string_view data) {
+  const PlyHeader h = parse_header(path, data);
+  const std::size_t data_bytes = data.size() - h.data_start;
+
+  // The declared counts must fit in the file before anything is allocated.
+  double needed = 0.0;
+  std::int64_t vertex_count = 0;
+  for (const PlyElement& e : h.elements) {
+    needed += static_cast<double>(e.count) * min_row_bytes(e, h.encoding);
+    if (e.name == "vertex") vertex_count = e.count;
+  }
+  if (needed > static_cast<double>(data_bytes) + 1.0)
+    fail(path, "the header declares more elements than the file's " +
+                   std::to_string(data.size()) + " bytes can hold (truncated file?)");
+  if (vertex_count > static_cast<std::int64_t>(UINT32_MAX)) fail(path, "too many vertices");
+
+  RawMesh out;
+  if (h.encoding == PlyEncoding::Ascii) {
+    TextCursor c(data, path, h.data_start);
+    read_elements(path, h, vertex_count, data_bytes,
+                  [&](const std::string& what) { return AsciiSource{c, what}; }, out);
+  } else {
+    const bool big = h.encoding == PlyEncoding::BinaryBig;
+    const bool swap = big != (std::endian::native == std::endian::big);
+    BinaryCursor b(path, data, h.data_start, swap);
+    std::string current;
+    read_elements(path, h, vertex_count, data_bytes,
+                  [&](const std::string& what) {
+                    current = what;
+                    b.set_context(&current);
+                    return BinarySource{b, current};
+                  },
+                  out);
+  }
+  return out;
+}
+
+}  // namespace sdfkit::io::detail
