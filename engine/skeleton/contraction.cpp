@@ -22,6 +22,9 @@ namespace {
 // Holding weights grow as sqrt(A0 / At); the growth is capped so that a fully collapsed
 // one-ring (At -> 0) stays a finite, well-conditioned constraint.
 constexpr double kMaxHoldingGrowth = 1e4;
+// A contraction step must not grow the surface area by more than this factor; one that does is
+// diverging (ill-conditioned system), so the loop stops with the state before it.
+constexpr double kMaxAreaGrowth = 1.25;
 
 void validate(const ContractionOptions& o) {
   auto bad = [](const std::string& what) { throw InputError("contraction option " + what); };
@@ -104,6 +107,7 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
       result.warnings.push_back("contraction stopped after " + std::to_string(it) +
                                 " iterations: the sparse factorization failed; the last good "
                                 "state is kept");
+      result.stop_reason = "factorization failed";
       break;
     }
     const Eigen::MatrixXd next = solver.solve(rhs);
@@ -113,18 +117,28 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
                                 "good state is kept");
       break;
     }
-    V = next;
+    Mesh candidate = current;
     for (std::size_t i = 0; i < n; ++i)
-      current.positions[i] = glm::vec3(V(static_cast<Eigen::Index>(i), 0),
-                                       V(static_cast<Eigen::Index>(i), 1),
-                                       V(static_cast<Eigen::Index>(i), 2));
+      candidate.positions[i] = glm::vec3(next(static_cast<Eigen::Index>(i), 0),
+                                         next(static_cast<Eigen::Index>(i), 1),
+                                         next(static_cast<Eigen::Index>(i), 2));
+    const std::vector<double> area = detail::one_ring_areas(candidate);
+    const double ratio = total0 > 0.0 ? total(area) / total0 : 0.0;
+    if (ratio > kMaxAreaGrowth * result.area_ratio) {
+      result.stop_reason = "the area stopped shrinking (ratio " + std::to_string(result.area_ratio) +
+                           ", next step " + std::to_string(ratio) + "); the last state is kept";
+      break;
+    }
+    V = next;
+    current = std::move(candidate);
     result.iterations = it + 1;
-
-    const std::vector<double> area = detail::one_ring_areas(current);
-    result.area_ratio = total0 > 0.0 ? total(area) / total0 : 0.0;
+    result.area_ratio = ratio;
     log_debug("contraction iteration " + std::to_string(it + 1) + ": area ratio " +
               std::to_string(result.area_ratio));
-    if (result.area_ratio < options.area_ratio_stop) break;
+    if (result.area_ratio < options.area_ratio_stop) {
+      result.stop_reason = "area ratio below " + std::to_string(options.area_ratio_stop);
+      break;
+    }
 
     wl *= options.sl;
     for (std::size_t i = 0; i < n; ++i) {
@@ -132,10 +146,14 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
       wh[i] = options.wh0 * std::min(growth, kMaxHoldingGrowth);
     }
   }
-  if (result.iterations == options.max_iterations && result.area_ratio >= options.area_ratio_stop)
+  if (result.iterations == options.max_iterations && result.area_ratio >= options.area_ratio_stop) {
+    result.stop_reason = "iteration cap";
     result.warnings.push_back("contraction reached the iteration cap (" +
                               std::to_string(options.max_iterations) + ") at area ratio " +
                               std::to_string(result.area_ratio));
+  }
+  if (result.stop_reason.empty()) result.stop_reason = "stopped early (see warnings)";
+  log_info("contraction: " + std::to_string(result.iterations) + " iterations, " + result.stop_reason);
   for (const std::string& w : result.warnings) log_warning(w);
   return result;
 }

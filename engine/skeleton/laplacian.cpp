@@ -9,7 +9,7 @@ namespace sdfkit::skeleton::detail {
 Eigen::SparseMatrix<double> cotangent_laplacian(const Mesh& mesh) {
   const auto n = static_cast<Eigen::Index>(mesh.positions.size());
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(mesh.triangles.size() * 12);
+  triplets.reserve(mesh.triangles.size() * 6);
   for (const Triangle& t : mesh.triangles) {
     const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[t[0]]), glm::dvec3(mesh.positions[t[1]]),
                              glm::dvec3(mesh.positions[t[2]])};
@@ -18,23 +18,31 @@ Eigen::SparseMatrix<double> cotangent_laplacian(const Mesh& mesh) {
     for (int k = 0; k < 3; ++k) {
       // Corner k is opposite the edge (i, j).
       const int i = (k + 1) % 3, j = (k + 2) % 3;
+      const auto vi = static_cast<Eigen::Index>(t[i]), vj = static_cast<Eigen::Index>(t[j]);
+      if (vi == vj) continue;
       double w = 0.0;
       if (!degenerate) {
         const glm::dvec3 a = p[i] - p[k], b = p[j] - p[k];
         const double sine = glm::length(glm::cross(a, b));
         w = std::clamp(glm::dot(a, b) / sine, -kMaxCotangent, kMaxCotangent);
       }
-      const auto vi = static_cast<Eigen::Index>(t[i]), vj = static_cast<Eigen::Index>(t[j]);
-      if (vi == vj) continue;
       triplets.emplace_back(vi, vj, w);
       triplets.emplace_back(vj, vi, w);
-      triplets.emplace_back(vi, vi, -w);
-      triplets.emplace_back(vj, vj, -w);
     }
   }
   Eigen::SparseMatrix<double> L(n, n);
-  L.setFromTriplets(triplets.begin(), triplets.end());
-  return L;
+  L.setFromTriplets(triplets.begin(), triplets.end());  // sums the two sides of each edge
+  std::vector<double> diagonal(static_cast<std::size_t>(n), 0.0);
+  for (Eigen::Index c = 0; c < L.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(L, c); it; ++it) {
+      it.valueRef() = std::max(it.value(), 0.0);
+      diagonal[static_cast<std::size_t>(c)] += it.value();
+    }
+  triplets.clear();
+  for (Eigen::Index c = 0; c < n; ++c) triplets.emplace_back(c, c, -diagonal[static_cast<std::size_t>(c)]);
+  Eigen::SparseMatrix<double> D(n, n);
+  D.setFromTriplets(triplets.begin(), triplets.end());
+  return L + D;
 }
 
 std::vector<double> one_ring_areas(const Mesh& mesh) {

@@ -223,7 +223,7 @@ Plate c_shape(float radius, float arc_degrees, float thickness, float height, fl
   const int steps = std::max(4, static_cast<int>(std::lround(arc * radius / cell)));
   std::vector<glm::vec2> curve;
   // Opening toward +x, symmetric about the x axis.
-  append_arc(curve, {0, 0}, radius, arc / 2.0, 2.0 * kPi - arc / 2.0, steps, false);
+  append_arc(curve, {0, 0}, radius, kPi - arc / 2.0, kPi + arc / 2.0, steps, false);
   return plate(curve, thickness, height, cell);
 }
 

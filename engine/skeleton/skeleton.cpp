@@ -19,13 +19,11 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <cstdio>
+#include <cstdlib>
 
 namespace sdfkit::skeleton {
 namespace {
-
-// Rounds of "move the vertices that cannot see their node into the sheet, re-centre the curve
-// nodes that lost vertices, check again" before the remaining failures go to the sheet at once.
-constexpr int kSheetRounds = 8;
 
 // Everything about the input surface that node placement and visibility need.
 struct Surface {
@@ -53,6 +51,26 @@ struct Surface {
 
   bool sees(std::uint32_t k, const glm::vec3& p) const {
     return !bvh.segment_blocked(original.positions[k], p, k);
+  }
+
+  // A point inside the solid that vertex k sees, for a sheet node: the contracted position if
+  // that works, else half way to the first surface met on the way from the vertex toward the
+  // contracted position, toward its centre point, or along the inward normal (a vertex on a
+  // sharp edge can graze the surface on one of these), whichever first gives an inside point.
+  glm::vec3 sheet_point(std::uint32_t k) const {
+    const glm::vec3 u = original.positions[k], v = contracted.positions[k];
+    if (bvh.inside(v) && sees(k, v)) return v;
+    const float far = 2.0f * bounding_box(original.positions).diagonal();
+    for (const glm::vec3& target : {v, centre[k], u - normals[k]}) {
+      const glm::vec3 d = target - u;
+      const float len = glm::length(d);
+      if (!(len > 0.0f)) continue;
+      const auto hit = bvh.closest(u, d / len, 0.0f, far, k);
+      if (!hit.found) continue;
+      const glm::vec3 p = u + (0.5f * hit.t / len) * d;
+      if (bvh.inside(p) && sees(k, p)) return p;
+    }
+    return centre[k];
   }
 
   // A node's position from its contracted position: moved by the area-weighted mean of its
@@ -141,37 +159,41 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   for (std::uint32_t c = 0; c < curve_nodes; ++c)
     position[c] = surface.place(graph.positions[c], members[c], options.refine_embedding);
 
-  auto failing_vertices = [&](const std::vector<std::uint8_t>& in_sheet) {
-    std::vector<std::uint32_t> out;
-    for (std::uint32_t k = 0; k < n; ++k)
-      if (!in_sheet[k] && !surface.sees(k, position[owner[k]])) out.push_back(k);
-    return out;
-  };
-
-  Skeleton sk;
+  // A vertex that cannot see its node moves to the closest neighbouring node it can see.
+  std::vector<std::vector<std::uint32_t>> graph_adjacency(curve_nodes);
+  for (const auto& e : graph.edges) {
+    graph_adjacency[e[0]].push_back(e[1]);
+    graph_adjacency[e[1]].push_back(e[0]);
+  }
   std::vector<std::uint8_t> in_sheet(n, 0);
-  std::vector<std::uint32_t> failing = failing_vertices(in_sheet);
-  sk.curve_reliability = 1.0 - static_cast<double>(failing.size()) / static_cast<double>(n);
-
-  if (options.sheets && !failing.empty()) {
-    const Adjacency ring = vertex_adjacency(original);
-    for (int round = 0; !failing.empty(); ++round) {
-      for (std::uint32_t k : failing) {
+  std::size_t failing = 0;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    if (surface.sees(k, position[owner[k]])) continue;
+    std::vector<std::pair<float, std::uint32_t>> options_by_distance;
+    for (std::uint32_t c : graph_adjacency[owner[k]])
+      options_by_distance.push_back({glm::length(position[c] - original.positions[k]), c});
+    std::sort(options_by_distance.begin(), options_by_distance.end());
+    bool moved = false;
+    for (const auto& [d, c] : options_by_distance)
+      if (surface.sees(k, position[c])) {
+        std::erase(members[owner[k]], k);
+        members[c].push_back(k);
+        owner[k] = c;
+        moved = true;
+        break;
+      }
+    if (!moved) {
+      ++failing;
+      // Sheets: the vertex leaves its curve node and becomes a sheet node (below). Curve nodes
+      // keep their positions, so no other vertex's visibility changes.
+      if (options.sheets) {
         in_sheet[k] = 1;
-        if (round < kSheetRounds)
-          for (std::uint32_t e = ring.offsets[k]; e < ring.offsets[k + 1]; ++e)
-            in_sheet[ring.indices[e]] = 1;
+        std::erase(members[owner[k]], k);
       }
-      // Curve nodes that lost vertices are placed again from the vertices they keep.
-      for (std::uint32_t c = 0; c < curve_nodes; ++c) {
-        const std::size_t before = members[c].size();
-        std::erase_if(members[c], [&](std::uint32_t k) { return in_sheet[k] != 0; });
-        if (!members[c].empty() && members[c].size() != before)
-          position[c] = surface.place(graph.positions[c], members[c], options.refine_embedding);
-      }
-      failing = round < kSheetRounds ? failing_vertices(in_sheet) : std::vector<std::uint32_t>{};
     }
   }
+  Skeleton sk;
+  sk.curve_reliability = 1.0 - static_cast<double>(failing) / static_cast<double>(n);
 
   // Curve nodes that still represent vertices, in order, then one sheet node per sheet vertex.
   std::vector<std::uint32_t> node_of_curve(curve_nodes, UINT32_MAX);
@@ -190,8 +212,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
       Node node;
       node.sheet = true;
       node.vertices = {k};
-      const glm::vec3 v = contracted.positions[k];
-      node.position = surface.bvh.inside(v) && surface.sees(k, v) ? v : surface.centre[k];
+      node.position = surface.sheet_point(k);
       node.radius = surface.radius(node.position, node.vertices);
       node_of_vertex[k] = static_cast<std::uint32_t>(sk.nodes.size());
       sk.nodes.push_back(std::move(node));
@@ -226,7 +247,16 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
     if (!sheet_edges.count(e)) sk.edges.push_back(e);
 
   std::size_t seen = 0;
-  for (std::uint32_t k = 0; k < n; ++k) seen += surface.sees(k, sk.nodes[node_of_vertex[k]].position);
+  for (std::uint32_t k = 0; k < n; ++k) {
+    const bool ok = surface.sees(k, sk.nodes[node_of_vertex[k]].position);
+    seen += ok;
+    if (!ok && std::getenv("SK_DEBUG")) {
+      const glm::vec3 u = original.positions[k];
+      const glm::vec3 p = sk.nodes[node_of_vertex[k]].position;
+      std::fprintf(stderr, "k=%u sheet=%d u=(%g %g %g) n=(%g %g %g) p=(%g %g %g) centre=(%g %g %g)\n", k, in_sheet[k], u.x, u.y, u.z,
+        surface.normals[k].x, surface.normals[k].y, surface.normals[k].z, p.x, p.y, p.z, surface.centre[k].x, surface.centre[k].y, surface.centre[k].z);
+    }
+  }
   sk.reliability = static_cast<double>(seen) / static_cast<double>(n);
   if (sk.reliability < 1.0)
     sk.warnings.push_back(std::to_string(n - seen) + " of " + std::to_string(n) +

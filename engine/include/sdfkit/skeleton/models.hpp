@@ -47,7 +47,7 @@ struct Star {
   Implicit fn;
 };
 Star five_armed_star(std::array<float, 5> radii = {0.18f, 0.24f, 0.30f, 0.36f, 0.42f},
-                     float arm_length = 2.0f, float centre_radius = 0.55f, float cell = 0.09f);
+                     float arm_length = 2.0f, float centre_radius = 0.55f, float cell = 0.15f);
 
 // Two solid tori (tube radius `minor`, ring radius `major`) in the xy plane with centres at
 // x = -/+ separation/2, fused where they overlap by a smooth union: genus 2. `axis`: the two
@@ -57,6 +57,6 @@ struct Genus2 {
   std::vector<Segment> axis;
   Implicit fn;
 };
-Genus2 genus2(float major = 1.0f, float minor = 0.3f, float separation = 2.2f, float cell = 0.08f);
+Genus2 genus2(float major = 1.0f, float minor = 0.3f, float separation = 2.2f, float cell = 0.12f);
 
 }  // namespace sdfkit::skeleton::models

@@ -40,7 +40,8 @@ struct ContractionOptions {
   double wc = 0.5;
   bool sdf_term = true;   // use the centering term and the SDF holding weights (needs a backend)
   double sdf_bias = 0.01; // W_H_i /= SDFnorm_i * (1 - bias) + bias
-  // Stop when the total one-ring area falls below this fraction of the initial area.
+  // Stop when the total area falls below this fraction of the initial area (or when a step would
+// grow the area: see ContractionResult::stop_reason).
   double area_ratio_stop = 1e-3;
   int max_iterations = 20;  // hard cap on the iterations (>= 1)
   SdfOptions sdf;           // options of the SDF recomputed at every iteration (domain: Vertex)
@@ -52,6 +53,11 @@ struct ContractionResult {
   std::vector<float> first_sdf; // per-vertex SDF of the input mesh (empty without SDF term)
   std::vector<float> last_sdf;  // per-vertex SDF of the last contracted mesh that was measured
   double area_ratio = 1.0;      // total area now / initial total area
+  // Why the loop ended: "area ratio below ...", "the area stopped shrinking ..." (a step would
+  // have grown the total area by over 25%: the contraction has converged as far as it goes,
+  // the remaining un-contracted parts are grouped by the surgery), "iteration cap", or a
+  // failure (also in warnings).
+  std::string stop_reason;
   std::vector<std::string> warnings;
 };
 
