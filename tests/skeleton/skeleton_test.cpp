@@ -1,64 +1,214 @@
-#include "sdfkit/core/shapes.hpp"
+// Skeletons of shapes with a known medial axis and topology, computed with the Embree reference
+// as the SDF backend (recomputed at every contraction iteration).
+
+#include "sdfkit/core/error.hpp"
 #include "sdfkit/core/log.hpp"
+#include "sdfkit/core/shapes.hpp"
 #include "sdfkit/reference/embree_backend.hpp"
 #include "sdfkit/skeleton/models.hpp"
 #include "sdfkit/skeleton/skeleton.hpp"
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
-#include <chrono>
+#include <cmath>
 #include <cstdio>
-#include <map>
+#include <numeric>
+#include <sstream>
 
 using namespace sdfkit;
 namespace sk = sdfkit::skeleton;
 namespace models = sdfkit::skeleton::models;
 
 namespace {
-void report(const char* name, const Mesh& m, bool sdf, const std::vector<models::Segment>* axis = nullptr) {
+
+sk::Skeleton run(const Mesh& mesh, bool sdf_term, bool sheets) {
   reference::EmbreeBackend backend;
   sk::ContractionOptions co;
-  co.sdf_term = sdf;
+  co.sdf_term = sdf_term;
   sk::SkeletonOptions so;
-  const auto t0 = std::chrono::steady_clock::now();
-  const sk::ContractionResult c = sk::contract(m, sdf ? &backend : nullptr, co);
-  const double cms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  const sk::Skeleton s = sk::build_skeleton(m, c.contracted, c.first_sdf, so);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  std::map<std::size_t, int> degree_hist;
-  std::vector<int> deg(s.nodes.size());
-  for (auto& e : s.edges) { deg[e[0]]++; deg[e[1]]++; }
-  for (int d : deg) degree_hist[static_cast<std::size_t>(d)]++;
-  std::size_t sheet_nodes = 0;
-  for (auto& n : s.nodes) sheet_nodes += n.sheet;
-  double axis_mean = 0, axis_max = 0;
-  if (axis) {
-    for (auto& n : s.nodes) { float d = models::distance_to(*axis, n.position); axis_mean += d; axis_max = std::max<double>(axis_max, d); }
-    axis_mean /= s.nodes.size();
-  }
-  std::printf("%s sdf=%d V=%zu: %.0f ms (contract %.0f, %s) it=%d nodes=%zu (sheet %zu) edges=%zu tris=%zu cycles=%d rel=%.3f curve_rel=%.3f axis mean %.4f max %.4f deg:",
-              name, sdf, m.positions.size(), ms, cms, c.stop_reason.c_str(), c.iterations, s.nodes.size(), sheet_nodes, s.edges.size(),
-              s.sheet_triangles.size(), sk::cycle_count(s), s.reliability, s.curve_reliability, axis_mean, axis_max);
-  for (auto [d, cnt] : degree_hist) std::printf(" %zu:%d", d, cnt);
-  std::printf("\n");
-  for (auto& w : s.warnings) std::printf("   warning: %s\n", w.c_str());
+  so.sheets = sheets;
+  return sk::extract(mesh, &backend, co, so);
 }
+
+std::vector<int> degrees(const sk::Skeleton& s) {
+  std::vector<int> d(s.nodes.size(), 0);
+  for (const auto& e : s.edges) ++d[e[0]], ++d[e[1]];
+  return d;
+}
+
+int count_degree(const sk::Skeleton& s, int degree) {
+  const auto d = degrees(s);
+  return static_cast<int>(std::count(d.begin(), d.end(), degree));
+}
+
+// Generalized winding number of a closed mesh at p (solid angles, Van Oosterom & Strackee):
+// independent of the library's ray-based inside test.
+double winding_number(const Mesh& m, const glm::vec3& p) {
+  double total = 0.0;
+  for (const Triangle& t : m.triangles) {
+    const glm::dvec3 a = glm::dvec3(m.positions[t[0]]) - glm::dvec3(p);
+    const glm::dvec3 b = glm::dvec3(m.positions[t[1]]) - glm::dvec3(p);
+    const glm::dvec3 c = glm::dvec3(m.positions[t[2]]) - glm::dvec3(p);
+    const double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+    const double num = glm::dot(a, glm::cross(b, c));
+    const double den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(b, c) * la + glm::dot(c, a) * lb;
+    total += 2.0 * std::atan2(num, den);
+  }
+  return total / (4.0 * M_PI);
+}
+
+// Every input vertex in exactly one node; every node inside the solid.
+void expect_partition_and_inside(const Mesh& mesh, const sk::Skeleton& s) {
+  std::vector<int> count(mesh.positions.size(), 0);
+  for (const sk::Node& n : s.nodes) {
+    EXPECT_FALSE(n.vertices.empty());
+    for (std::uint32_t v : n.vertices) ++count[v];
+    EXPECT_GT(winding_number(mesh, n.position), 0.5)
+        << "node at " << n.position.x << ' ' << n.position.y << ' ' << n.position.z;
+    EXPECT_TRUE(std::isfinite(n.radius));
+    EXPECT_GT(n.radius, 0.0f);
+  }
+  for (int c : count) ASSERT_EQ(c, 1);
+  for (const auto& e : s.edges) {
+    ASSERT_LT(e[0], e[1]);
+    ASSERT_LT(e[1], s.nodes.size());
+  }
+}
+
+double mean_distance(const sk::Skeleton& s, const std::vector<models::Segment>& axis) {
+  double sum = 0.0;
+  for (const sk::Node& n : s.nodes) sum += models::distance_to(axis, n.position);
+  return sum / static_cast<double>(s.nodes.size());
+}
+
 }  // namespace
 
-TEST(SkeletonProbe, DISABLED_Print) {
-  set_log_level(LogLevel::Debug);
-  const Mesh capsule = shapes::capsule(0.5f, 4.0f, 24, 24);
-  std::vector<models::Segment> cax = {{glm::vec3(0, 0, -2), glm::vec3(0, 0, 2)}};
-  for (bool sdf : {false, true}) {
-    if (::testing::GTEST_FLAG(filter).find("Star") != std::string::npos) { auto star = models::five_armed_star(); report("star", star.mesh, sdf, &star.axis); continue; }
-    report("capsule", capsule, sdf, &cax);
-    report("torus", shapes::torus(2.0f, 0.5f, 48, 16), sdf);
-    auto star = models::five_armed_star();
-    report("star", star.mesh, sdf, &star.axis);
-    auto g = models::genus2();
-    report("genus2", g.mesh, sdf, &g.axis);
-    report("C", models::c_shape().mesh, sdf);
-    report("S", models::s_shape().mesh, sdf);
+TEST(Skeleton, CapsuleGivesOneCurveNearItsAxis) {
+  const float radius = 0.5f, length = 4.0f;
+  const Mesh mesh = shapes::capsule(radius, length, 24, 24);
+  const sk::Skeleton s = run(mesh, true, true);
+  expect_partition_and_inside(mesh, s);
+  ASSERT_GE(s.nodes.size(), 2u);
+  EXPECT_EQ(s.edges.size(), s.nodes.size() - 1);  // a tree ...
+  EXPECT_EQ(sk::cycle_count(s), 0);
+  EXPECT_EQ(count_degree(s, 1), 2);               // ... with two ends: one curve
+  EXPECT_EQ(count_degree(s, 2), static_cast<int>(s.nodes.size()) - 2);
+  EXPECT_TRUE(s.sheet_triangles.empty());
+  const float total = length + 2.0f * radius;
+  for (const sk::Node& n : s.nodes) {
+    EXPECT_LT(std::hypot(n.position.x, n.position.y), 0.02f * total);
+    EXPECT_LT(std::abs(n.position.z), 0.5f * total);
+    EXPECT_NEAR(n.radius, radius, 0.35f * radius);  // SDF/2 of a tube is its radius (ends: less)
   }
+  EXPECT_DOUBLE_EQ(s.reliability, 1.0);
+}
+
+TEST(Skeleton, TorusGivesOneCycle) {
+  const Mesh mesh = shapes::torus(2.0f, 0.5f, 48, 16);
+  const sk::Skeleton s = run(mesh, true, true);
+  expect_partition_and_inside(mesh, s);
+  EXPECT_EQ(sk::cycle_count(s), 1);
+  EXPECT_EQ(count_degree(s, 2), static_cast<int>(s.nodes.size()));
+  for (const sk::Node& n : s.nodes)
+    EXPECT_NEAR(std::hypot(n.position.x, n.position.y), 2.0f, 0.1f);
+}
+
+TEST(Skeleton, Genus2GivesTwoCycles) {
+  const auto g = models::genus2();
+  const sk::Skeleton s = run(g.mesh, true, false);
+  expect_partition_and_inside(g.mesh, s);
+  EXPECT_EQ(sk::cycle_count(s), 2);
+  EXPECT_TRUE(s.sheet_triangles.empty());
+}
+
+TEST(Skeleton, StarGivesFiveBranchesFromOneJunction) {
+  const auto star = models::five_armed_star();
+  const sk::Skeleton s = run(star.mesh, true, false);
+  expect_partition_and_inside(star.mesh, s);
+  EXPECT_EQ(sk::cycle_count(s), 0);
+  EXPECT_EQ(count_degree(s, 1), 5);
+  EXPECT_EQ(count_degree(s, 5), 1);
+  EXPECT_EQ(count_degree(s, 1) + count_degree(s, 2) + count_degree(s, 5),
+            static_cast<int>(s.nodes.size()));
+  // The junction sits at the centre of the star, each end near its arm's end.
+  const auto d = degrees(s);
+  for (std::size_t i = 0; i < s.nodes.size(); ++i)
+    if (d[i] == 5) {
+      EXPECT_LT(glm::length(s.nodes[i].position), 0.3f);
+    }
+}
+
+TEST(Skeleton, SdfTermBringsNodesCloserToTheMedialAxis) {
+  const auto star = models::five_armed_star();
+  const double with = mean_distance(run(star.mesh, true, false), star.axis);
+  const double without = mean_distance(run(star.mesh, false, false), star.axis);
+  std::printf("star: mean node distance to the medial axis: with SDF term %.4f, without %.4f\n",
+              with, without);
+  EXPECT_LT(with, without);
+}
+
+TEST(Skeleton, SheetsMakeTheCAndSShapesFullyReliable) {
+  for (const auto& plate : {models::c_shape(), models::s_shape()}) {
+    const sk::Skeleton curves = run(plate.mesh, true, false);
+    const sk::Skeleton sheets = run(plate.mesh, true, true);
+    std::printf("plate: curve reliability %.3f, with sheets %.3f (%zu sheet triangles)\n",
+                curves.reliability, sheets.reliability, sheets.sheet_triangles.size());
+    EXPECT_LT(curves.reliability, 0.9);  // a curve cannot serve a non-convex cross-section
+    EXPECT_DOUBLE_EQ(sheets.reliability, 1.0);
+    EXPECT_FALSE(sheets.sheet_triangles.empty());
+    expect_partition_and_inside(plate.mesh, sheets);
+  }
+}
+
+TEST(Skeleton, OpenMeshIsRefusedWithAClearError) {
+  Mesh open = shapes::capsule(0.5f, 2.0f, 16, 8);
+  open.triangles.pop_back();
+  try {
+    run(open, true, true);
+    FAIL() << "an open mesh was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("boundary edges"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Skeleton, SeveralComponentsGiveOnePartEach) {
+  Mesh a = shapes::capsule(0.4f, 2.0f, 16, 12);
+  const Mesh b = shapes::torus(1.5f, 0.4f, 32, 12);
+  const auto offset = static_cast<std::uint32_t>(a.positions.size());
+  for (glm::vec3 p : b.positions) a.positions.push_back(p + glm::vec3(5.0f, 0.0f, 0.0f));
+  for (Triangle t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  const sk::Skeleton s = run(a, true, false);
+  expect_partition_and_inside(a, s);
+  EXPECT_EQ(sk::cycle_count(s), 1);  // the torus' cycle; the capsule's tree adds none
+  for (const sk::Node& n : s.nodes) {
+    const bool first = n.vertices.front() < offset;
+    for (std::uint32_t v : n.vertices) EXPECT_EQ(v < offset, first);  // no node spans both
+  }
+  for (const auto& e : s.edges)
+    EXPECT_EQ(s.nodes[e[0]].vertices.front() < offset, s.nodes[e[1]].vertices.front() < offset);
+}
+
+TEST(Skeleton, JsonAndObjCarryNodesEdgesAndSheets) {
+  const auto plate = models::c_shape();
+  const sk::Skeleton s = run(plate.mesh, true, true);
+  const auto j = nlohmann::json::parse(sk::to_json(s));
+  ASSERT_EQ(j["nodes"].size(), s.nodes.size());
+  EXPECT_EQ(j["edges"].size(), s.edges.size());
+  EXPECT_EQ(j["sheet_triangles"].size(), s.sheet_triangles.size());
+  EXPECT_EQ(j["nodes"][0]["vertices"].size(), s.nodes[0].vertices.size());
+  EXPECT_FLOAT_EQ(j["nodes"][0]["position"][0].get<float>(), s.nodes[0].position.x);
+  std::ostringstream obj;
+  sk::write_obj(obj, s);
+  std::size_t v = 0, l = 0, f = 0;
+  std::istringstream in(obj.str());
+  for (std::string line; std::getline(in, line);) {
+    v += line.rfind("v ", 0) == 0;
+    l += line.rfind("l ", 0) == 0;
+    f += line.rfind("f ", 0) == 0;
+  }
+  EXPECT_EQ(v, s.nodes.size());
+  EXPECT_EQ(l, s.edges.size());
+  EXPECT_EQ(f, s.sheet_triangles.size());
 }
