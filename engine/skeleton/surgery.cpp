@@ -34,7 +34,7 @@ Eigen::Matrix4d edge_quadric(const glm::dvec3& p, const glm::dvec3& q) {
 // The simplicial complex being collapsed: vertices (nodes) with their edges and triangles.
 class Complex {
 public:
-  Complex(const Mesh& mesh, std::span<const float> radius) {
+  Complex(const Mesh& mesh, std::span<const float> radius, std::span<const glm::vec3> centres) {
     const std::size_t n = mesh.positions.size();
     p_.resize(n);
     for (std::size_t i = 0; i < n; ++i) p_[i] = glm::dvec3(mesh.positions[i]);
@@ -42,11 +42,13 @@ public:
     vf_.resize(n);
     members_.resize(n);
     radius_sum_.assign(n, 0.0);
+    centre_sum_.assign(n, glm::dvec3(0.0));
     alive_.assign(n, 1);
     stamp_.assign(n, 0);
     for (std::uint32_t i = 0; i < n; ++i) {
       members_[i] = {i};
       if (i < radius.size()) radius_sum_[i] = radius[i];
+      centre_sum_[i] = glm::dvec3(i < centres.size() ? centres[i] : mesh.positions[i]);
     }
     faces_ = mesh.triangles;
     face_alive_.assign(faces_.size(), 1);
@@ -75,6 +77,9 @@ public:
   const std::vector<std::uint32_t>& members(std::uint32_t i) const { return members_[i]; }
   double radius(std::uint32_t i) const {
     return radius_sum_[i] / static_cast<double>(members_[i].size());
+  }
+  glm::dvec3 embedded(std::uint32_t i) const {
+    return centre_sum_[i] / static_cast<double>(members_[i].size());
   }
   std::uint32_t stamp(std::uint32_t i) const { return stamp_[i]; }
   void bump(std::uint32_t i) { ++stamp_[i]; }
@@ -135,6 +140,7 @@ public:
     members_[j].insert(members_[j].end(), members_[i].begin(), members_[i].end());
     members_[i].clear();
     radius_sum_[j] += radius_sum_[i];
+    centre_sum_[j] += centre_sum_[i];
     alive_[i] = 0;
   }
 
@@ -152,6 +158,7 @@ private:
   std::vector<glm::dvec3> p_;
   std::vector<std::vector<std::uint32_t>> nbr_, vf_, members_;
   std::vector<double> radius_sum_;
+  std::vector<glm::dvec3> centre_sum_;
   std::vector<std::uint8_t> alive_;
   std::vector<std::uint32_t> stamp_;
   std::vector<Triangle> faces_;
@@ -201,11 +208,12 @@ void group_nodes(Complex& c, const SurgeryOptions& o, std::size_t& groupings) {
     for (std::uint32_t i = 0; i < c.size(); ++i)
       if (c.alive(i))
         for (std::uint32_t j : c.neighbours(i))
-          if (i < j) edges.push_back({glm::length(c.position(i) - c.position(j)), {i, j}});
+          if (i < j) edges.push_back({glm::length(c.embedded(i) - c.embedded(j)), {i, j}});
     std::sort(edges.begin(), edges.end());
     for (const auto& [length, e] : edges) {
       const auto [a, b] = e;
       if (!c.alive(a) || !c.alive(b) || !contains(c.neighbours(a), b)) continue;
+      if (glm::length(c.embedded(a) - c.embedded(b)) != length) continue;  // moved; next pass
       // The node representing fewer vertices goes into the other one.
       const bool a_goes = c.members(a).size() < c.members(b).size() ||
                           (c.members(a).size() == c.members(b).size() && a > b);
@@ -222,8 +230,8 @@ void group_nodes(Complex& c, const SurgeryOptions& o, std::size_t& groupings) {
 }  // namespace
 
 CurveGraph collapse_to_curves(const Mesh& contracted, std::span<const float> radius,
-                              const SurgeryOptions& options) {
-  Complex c(contracted, radius);
+                              std::span<const glm::vec3> centres, const SurgeryOptions& options) {
+  Complex c(contracted, radius, centres);
   CurveGraph g;
   remove_all_faces(c, options, g.collapses);
   group_nodes(c, options, g.groupings);

@@ -35,7 +35,11 @@ struct CurveGraph {
 // Cost = w_a F_a + w_b F_b; the cheapest half-edge lying on a triangle is collapsed first.
 // Grouping then collapses face-less edges shorter than the removed node's dt, shortest first,
 // never one whose end points share a neighbour (that would close a cycle of the skeleton).
+// Lengths for grouping are measured between the nodes' embedded positions, the mean of their
+// vertices' `centres` (per mesh vertex: a centre point inside the solid, model units), not
+// between contracted positions: mean-curvature contraction also shrinks a ring's radius, and
+// grouping on the shrunk ring left a torus with three nodes.
 CurveGraph collapse_to_curves(const Mesh& contracted, std::span<const float> radius,
-                              const SurgeryOptions& options);
+                              std::span<const glm::vec3> centres, const SurgeryOptions& options);
 
 }  // namespace sdfkit::skeleton::detail
