@@ -71,7 +71,7 @@ struct SdfkitRun {
   double seconds = 0.0, contract_seconds = 0.0;
   int iterations = 0;
   std::size_t nodes = 0, edges = 0, sheet_triangles = 0;
-  double reliability = 0.0;
+  double reliability = 0.0, curve_reliability = 0.0;
   std::string stop;
 };
 
@@ -98,6 +98,7 @@ SdfkitRun run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend) {
   r.edges = s.edges.size();
   r.sheet_triangles = s.sheet_triangles.size();
   r.reliability = s.reliability;
+  r.curve_reliability = s.curve_reliability;
   return r;
 }
 
@@ -114,7 +115,7 @@ int main(int argc, char** argv) {
     sdfkit::reference::EmbreeBackend backend;
     std::printf("SDF backend: %s\n\n", backend.device_name().c_str());
     std::printf("| mesh | vertices | sdfkit s (contraction s) | sdfkit iterations | nodes / edges / "
-                "sheet tris | reliability | CGAL MCF s | CGAL iterations | CGAL nodes / edges | "
+                "sheet tris | curve reliability | CGAL MCF s | CGAL iterations | CGAL nodes / edges | "
                 "sdfkit / CGAL time |\n|---|---|---|---|---|---|---|---|---|---|\n");
     for (const std::string& path : paths) {
       const sdfkit::io::Asset asset = sdfkit::io::load_asset(path);
@@ -123,7 +124,7 @@ int main(int argc, char** argv) {
       const std::string name = path.substr(path.find_last_of('/') + 1);
       std::printf("| %s | %zu | %.2f (%.2f) | %d | %zu / %zu / %zu | %.1f%% | %.2f | %d | %zu / %zu | %.2f |\n",
                   name.c_str(), asset.mesh.positions.size(), a.seconds, a.contract_seconds,
-                  a.iterations, a.nodes, a.edges, a.sheet_triangles, 100.0 * a.reliability,
+                  a.iterations, a.nodes, a.edges, a.sheet_triangles, 100.0 * a.curve_reliability,
                   b.seconds, b.iterations, b.nodes, b.edges, a.seconds / b.seconds);
       std::fflush(stdout);
       sdfkit::log_info(name + ": sdfkit contraction stopped: " + a.stop);

@@ -70,6 +70,8 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
 
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
   std::vector<float> thickness;  // per vertex: the smallest SDF measured so far
+  Eigen::Index pattern_nonzeros = 0;
+  double factor_ms = 0.0;
   using Clock = std::chrono::steady_clock;
   auto ms_since = [](Clock::time_point t) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -121,7 +123,17 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
     }
     for (Eigen::Index r = 0; r < A.outerSize(); ++r) A.coeffRef(r, r) += diagonal(r);
 
-    solver.compute(A);
+    // The sparsity pattern depends only on the connectivity (every edge is stored, also with
+    // weight 0), so the fill-reducing ordering and symbolic analysis are done once. (Measured
+    // on refined_elephant, 44k vertices: factorization ~0.28 s CPU per iteration; the
+    // quasi-definite augmented system [-I, L; L, D/W_L^2] has the same fill and cost.)
+    const double build_ms = ms_since(t_solve);
+    if (it == 0 || A.nonZeros() != pattern_nonzeros) {
+      solver.analyzePattern(A);
+      pattern_nonzeros = A.nonZeros();
+    }
+    solver.factorize(A);
+    factor_ms = ms_since(t_solve) - build_ms;
     if (solver.info() != Eigen::Success) {
       result.warnings.push_back("contraction stopped after " + std::to_string(it) +
                                 " iterations: the sparse factorization failed; the last good "
@@ -155,7 +167,8 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
     result.area_ratio = ratio;
     log_debug("contraction iteration " + std::to_string(it + 1) + ": area ratio " +
               std::to_string(result.area_ratio) + ", SDF " + std::to_string(sdf_ms) +
-              " ms, solve " + std::to_string(solve_ms) + " ms");
+              " ms, solve " + std::to_string(solve_ms) + " ms (factorization " +
+              std::to_string(factor_ms) + " ms)");
     if (result.area_ratio < options.area_ratio_stop) {
       result.stop_reason = "area ratio below " + std::to_string(options.area_ratio_stop);
       break;

@@ -15,12 +15,12 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <set>
-#include <cstdio>
-#include <cstdlib>
 
 namespace sdfkit::skeleton {
 namespace {
@@ -175,6 +175,20 @@ void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in
   }
 }
 
+// Wall-clock time of the stages of build_skeleton, logged at debug level.
+class Stopwatch {
+public:
+  void lap(const char* stage) {
+    const auto now = std::chrono::steady_clock::now();
+    log_debug(std::string("skeleton: ") + stage + " " +
+              std::to_string(std::chrono::duration<double, std::milli>(now - last_).count()) + " ms");
+    last_ = now;
+  }
+
+private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 // Nodes nearest to a vertex that are tried when it cannot see its own node.
 constexpr std::size_t kNearestNodes = 8;
 
@@ -211,9 +225,12 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   so.sampling_weight = options.sampling_weight;
   so.grouping_global = options.ggt * diag;
   so.grouping_local = options.gmt;
+  Stopwatch watch;
   const Surface surface(original, contracted, sdf);
+  watch.lap("BVH and centre points");
   const detail::CurveGraph graph =
       detail::collapse_to_curves(contracted, local_radius, surface.centre, so);
+  watch.lap("connectivity surgery");
 
   const std::size_t curve_nodes = graph.positions.size();
   std::vector<std::uint32_t> owner(n);
@@ -225,6 +242,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   for (std::uint32_t c = 0; c < curve_nodes; ++c)
     position[c] = surface.place(graph.positions[c], members[c], options.refine_embedding);
 
+  watch.lap("node placement");
   // A vertex that cannot see its node moves to the closest node it can see among the node's
   // graph neighbours and the kNearestNodes nodes nearest to the vertex.
   std::vector<std::vector<std::uint32_t>> graph_adjacency(curve_nodes);
@@ -268,6 +286,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   }
   Skeleton sk;
   sk.curve_reliability = 1.0 - static_cast<double>(failing) / static_cast<double>(n);
+  watch.lap("visibility");
 
   // Curve nodes that still represent vertices, in order, then one sheet node per sheet vertex.
   std::vector<std::uint32_t> node_of_curve(curve_nodes, UINT32_MAX);
@@ -284,6 +303,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   for (std::uint32_t k = 0; k < n; ++k)
     if (!in_sheet[k]) node_of_vertex[k] = node_of_curve[owner[k]];
   add_sheet_nodes(surface, in_sheet, options.sheet_spacing * diag, sk.nodes, node_of_vertex);
+  watch.lap("sheet nodes");
 
   std::set<std::array<std::uint32_t, 2>> edges;
   auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
@@ -291,6 +311,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   };
   for (const auto& e : graph.edges) add_edge(node_of_curve[e[0]], node_of_curve[e[1]]);
   std::set<Triangle> sheet_seen;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> links;  // (curve node, sheet node)
   for (const Triangle& t : original.triangles) {
     const bool s0 = in_sheet[t[0]], s1 = in_sheet[t[1]], s2 = in_sheet[t[2]];
     if (s0 && s1 && s2) {
@@ -305,11 +326,34 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
       }
       continue;
     }
-    // Where the sheet meets a curve, connect the two through the mesh's edges.
     for (int i = 0; i < 3; ++i) {
       const std::uint32_t a = t[i], b = t[(i + 1) % 3];
-      if (in_sheet[a] != in_sheet[b]) add_edge(node_of_vertex[a], node_of_vertex[b]);
+      if (in_sheet[a] && in_sheet[b])
+        add_edge(node_of_vertex[a], node_of_vertex[b]);  // keeps the sheet connected
+      else if (in_sheet[a] != in_sheet[b])
+        links.push_back({node_of_vertex[in_sheet[a] ? b : a], node_of_vertex[in_sheet[a] ? a : b]});
     }
+  }
+  // Where the sheet meets a curve: each curve node is linked to the nearest sheet node it
+  // touches (through a mesh edge) in each connected piece of sheet, so a curve meets a sheet in
+  // one edge instead of a fan of edges that would close spurious cycles.
+  {
+    std::vector<std::uint32_t> piece(sk.nodes.size());
+    std::iota(piece.begin(), piece.end(), 0u);
+    auto find = [&](std::uint32_t x) {
+      while (piece[x] != x) x = piece[x] = piece[piece[x]];
+      return x;
+    };
+    for (const auto& e : edges) piece[find(e[0])] = find(e[1]);
+    for (const Triangle& t : sk.sheet_triangles) piece[find(t[0])] = find(t[1]), piece[find(t[1])] = find(t[2]);
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<float, std::uint32_t>> best;
+    for (const auto& [curve, sheet] : links) {
+      if (curve == UINT32_MAX || sheet == UINT32_MAX) continue;
+      const float d = glm::length(sk.nodes[curve].position - sk.nodes[sheet].position);
+      auto [it, inserted] = best.try_emplace({curve, find(sheet)}, d, sheet);
+      if (!inserted && d < it->second.first) it->second = {d, sheet};
+    }
+    for (const auto& [key, value] : best) add_edge(key.first, value.second);
   }
   // Sheet-triangle edges are part of the sheet, not curve edges.
   std::set<std::array<std::uint32_t, 2>> sheet_edges;
@@ -323,14 +367,9 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   for (std::uint32_t k = 0; k < n; ++k) {
     const bool ok = surface.sees(k, sk.nodes[node_of_vertex[k]].position);
     seen += ok;
-    if (!ok && std::getenv("SK_DEBUG")) {
-      const glm::vec3 u = original.positions[k];
-      const glm::vec3 p = sk.nodes[node_of_vertex[k]].position;
-      std::fprintf(stderr, "k=%u sheet=%d u=(%g %g %g) n=(%g %g %g) p=(%g %g %g) centre=(%g %g %g)\n", k, in_sheet[k], u.x, u.y, u.z,
-        surface.normals[k].x, surface.normals[k].y, surface.normals[k].z, p.x, p.y, p.z, surface.centre[k].x, surface.centre[k].y, surface.centre[k].z);
-    }
   }
   sk.reliability = static_cast<double>(seen) / static_cast<double>(n);
+  watch.lap("edges, sheets and reliability");
   if (sk.reliability < 1.0)
     sk.warnings.push_back(std::to_string(n - seen) + " of " + std::to_string(n) +
                           " surface vertices cannot see their skeleton node" +

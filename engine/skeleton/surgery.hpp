@@ -24,6 +24,7 @@ struct CurveGraph {
   std::vector<std::array<std::uint32_t, 2>> edges;   // i < j
   std::size_t collapses = 0;
   std::size_t groupings = 0;
+  std::size_t pruned_cycles = 0;  // spurious cycles removed (see collapse_to_curves)
 };
 
 // `contracted`: the contracted mesh (closed input connectivity). `radius`: per mesh vertex, the
@@ -39,6 +40,11 @@ struct CurveGraph {
 // vertices' `centres` (per mesh vertex: a centre point inside the solid, model units), not
 // between contracted positions: mean-curvature contraction also shrinks a ring's radius, and
 // grouping on the shrunk ring left a torus with three nodes.
+// Half-edge collapses without a link condition can leave short cycles where a flat part
+// collapsed (measured: 3 on CGAL's elephant, 27 on refined_elephant, both genus 0). A solid
+// bounded by a closed surface of genus g has a curve skeleton with g independent cycles, so
+// per component only the g longest fundamental cycles of the minimum spanning tree (edge
+// lengths between embedded positions) are kept; the closing edges of the others are removed.
 CurveGraph collapse_to_curves(const Mesh& contracted, std::span<const float> radius,
                               std::span<const glm::vec3> centres, const SurgeryOptions& options);
 

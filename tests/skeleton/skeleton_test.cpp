@@ -212,12 +212,3 @@ TEST(Skeleton, JsonAndObjCarryNodesEdgesAndSheets) {
   EXPECT_EQ(l, s.edges.size());
   EXPECT_EQ(f, s.sheet_triangles.size());
 }
-
-TEST(Skeleton, DISABLED_Debug) {
-  set_log_level(LogLevel::Debug);
-  const Mesh mesh = shapes::torus(2.0f, 0.5f, 48, 16);
-  const sk::Skeleton s = run(mesh, true, true);
-  std::printf("nodes %zu curve_rel %.3f rel %.3f\n", s.nodes.size(), s.curve_reliability, s.reliability);
-  for (const auto& n : s.nodes)
-    if (!n.sheet) std::printf("  node (%.3f %.3f %.3f) r=%.3f members %zu\n", n.position.x, n.position.y, n.position.z, n.radius, n.vertices.size());
-}
