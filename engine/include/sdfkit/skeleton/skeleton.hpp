@@ -47,7 +47,8 @@ struct ContractionOptions {
   // contraction scales with r^2 / h^2: dividing by the mean face area (in diag^2) makes the
   // iteration count independent of units and resolution. Measured on CGAL's elephant with the
   // SDF term: wl_scale 1e-3 -> 13 iterations, 1e-4 -> 17; Au's literal value (in diag units)
-  // needed over 20.
+  // needed over 20. 1e-3 collapses the coarse test capsule (842 vertices) to a point in the
+  // first step, so the default is 1e-4.
   double wl_scale = 1e-4;
   double sl = 2.0;   // W_L is multiplied by sl after every iteration (Au: S_L = 2)
   double wh0 = 1.0;  // initial holding weight W_H0 for every vertex
@@ -94,7 +95,9 @@ struct SkeletonOptions {
   double sheet_spacing = 0.025;
   double shape_weight = 1.0;     // Au's w_a: weight of the quadric shape cost
   double sampling_weight = 0.1;  // Au's w_b: weight of the sampling cost
-  bool refine_embedding = true;  // move nodes toward the centre of their surface region
+  // Place each curve node at the centre of the part of the solid its vertices enclose (the mean
+  // of their SDF centre points u - SDF/2 n); off = the contracted position (if inside).
+  bool refine_embedding = true;
 };
 
 struct Node {
@@ -108,7 +111,9 @@ struct Skeleton {
   std::vector<Node> nodes;
   std::vector<std::array<std::uint32_t, 2>> edges;  // curve edges, indices into nodes, i < j
   std::vector<Triangle> sheet_triangles;            // sheet patches, indices into nodes
-  // Share of surface vertices whose node is visible from them along a segment inside the solid.
+  // Share of surface vertices whose node is visible from them along a segment inside the solid
+  // (a vertex that cannot see its node is first moved to the nearest node it sees; with sheets
+  // on, the vertices that see no curve node become sheet nodes, so this is 1).
   double reliability = 0.0;
   double curve_reliability = 0.0;  // the same for the curve skeleton before sheets were added
   int iterations = 0;              // contraction iterations
@@ -116,8 +121,11 @@ struct Skeleton {
 };
 
 // Contraction + connectivity surgery + refinement + sheets. `backend` may be nullptr (no SDF:
-// radii are the mean distance from a node to its vertices; grouping uses that radius).
-// Every input vertex belongs to exactly one node.
+// no centering term, radii are the mean distance from a node to its vertices, grouping uses the
+// distance from a vertex to its contracted position, centre points come from one ray along the
+// inward normal). With a backend and sdf_term off, the SDF is computed once (radii, grouping,
+// centre points) but not used in the contraction. Every input vertex belongs to exactly one
+// node; every node lies inside the solid.
 Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
                  const SkeletonOptions& options);
 
@@ -135,7 +143,9 @@ std::string to_json(const Skeleton& skeleton);
 // Wavefront OBJ: one `v` per node, `l` per edge, `f` per sheet triangle (1-based).
 void write_obj(std::ostream& out, const Skeleton& skeleton);
 
-// Cycles of the skeleton graph (curve edges and sheet triangle edges): E - V + components.
+// Independent cycles of the skeleton as a 2-complex (curve edges, sheet triangles and their
+// edges): E - V + components - F, i.e. the first Betti number when sheets enclose no volume.
+// For a curve skeleton (no sheets) this is the number of handles of the shape.
 int cycle_count(const Skeleton& skeleton);
 
 }  // namespace sdfkit::skeleton
