@@ -4,12 +4,15 @@
 #include "bvh.hpp"
 #include "laplacian.hpp"
 
+#include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
+#include "sdfkit/skeleton/skeleton.hpp"
 #include "sdfkit/skeleton/models.hpp"
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -71,5 +74,86 @@ TEST(SkeletonBvh, InsideAgreesWithTheImplicitTorus) {
     const float f = shapes::torus_sdf(p, 2.0f, 0.6f);
     if (std::abs(f) < 0.05f) continue;  // the tessellation differs from the ideal surface
     EXPECT_EQ(bvh.inside(p), f < 0.0f) << p.x << ' ' << p.y << ' ' << p.z;
+  }
+}
+
+TEST(SkeletonLaplacian, SymmetricNonNegativeWeightsRowsSumToZero) {
+  const Mesh m = skeleton::models::five_armed_star().mesh;  // marching-tetrahedra slivers
+  const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(m);
+  const Eigen::SparseMatrix<double> Lt = L.transpose();
+  EXPECT_NEAR((L - Lt).norm(), 0.0, 1e-9 * L.norm());
+  Eigen::VectorXd ones = Eigen::VectorXd::Ones(L.cols());
+  EXPECT_LT((L * ones).cwiseAbs().maxCoeff(), 1e-9 * L.norm());
+  for (Eigen::Index c = 0; c < L.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(L, c); it; ++it) {
+      ASSERT_TRUE(std::isfinite(it.value()));
+      if (it.row() != it.col()) {
+        EXPECT_GE(it.value(), 0.0);
+      }
+      EXPECT_LE(std::abs(it.value()), 2 * 6 * detail::kMaxCotangent * 20);
+    }
+}
+
+TEST(SkeletonLaplacian, FlatGridIsHarmonicAndASpherePointsInward) {
+  // A planar box face: L V vanishes at vertices inside a flat face (cot weights reproduce
+  // linear functions), and on a sphere L V points along the inward normal.
+  const Mesh box = shapes::box(2.0f, 2.0f, 2.0f, 6);
+  const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(box);
+  Eigen::MatrixXd V(box.positions.size(), 3);
+  for (std::size_t i = 0; i < box.positions.size(); ++i)
+    for (int k = 0; k < 3; ++k) V(static_cast<Eigen::Index>(i), k) = box.positions[i][k];
+  const Eigen::MatrixXd LV = L * V;
+  int interior = 0;
+  for (std::size_t i = 0; i < box.positions.size(); ++i) {
+    const glm::vec3 p = glm::abs(box.positions[i]);
+    const int on_faces = (p.x > 0.999f) + (p.y > 0.999f) + (p.z > 0.999f);
+    if (on_faces != 1) continue;
+    ++interior;
+    EXPECT_LT(LV.row(static_cast<Eigen::Index>(i)).norm(), 1e-5);
+  }
+  EXPECT_GT(interior, 50);
+
+  const Mesh sphere = shapes::icosphere(1.0f, 3);
+  const Eigen::SparseMatrix<double> Ls = detail::cotangent_laplacian(sphere);
+  for (std::size_t i = 0; i < sphere.positions.size(); ++i) {
+    glm::dvec3 lv(0.0);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(Ls, static_cast<Eigen::Index>(i)); it; ++it)
+      lv += it.value() * glm::dvec3(sphere.positions[static_cast<std::size_t>(it.row())]);
+    EXPECT_LT(glm::dot(lv, glm::dvec3(sphere.positions[i])), 0.0);
+  }
+}
+
+TEST(SkeletonContraction, PlainAuContractionShrinksWithoutNaN) {
+  const Mesh capsule = shapes::capsule(0.5f, 3.0f, 16, 12);
+  skeleton::ContractionOptions o;
+  const auto r = skeleton::contract(capsule, nullptr, o);
+  EXPECT_GE(r.iterations, 1);
+  EXPECT_LE(r.iterations, o.max_iterations);
+  EXPECT_LT(r.area_ratio, 0.01);
+  EXPECT_TRUE(r.first_sdf.empty());
+  EXPECT_EQ(r.contracted.triangles, capsule.triangles);
+  for (const glm::vec3& p : r.contracted.positions) {
+    ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+    EXPECT_LT(std::hypot(p.x, p.y), 0.1f);  // on the axis
+    EXPECT_LT(std::abs(p.z), 2.1f);
+  }
+}
+
+TEST(SkeletonContraction, IterationCapAndBadOptions) {
+  const Mesh capsule = shapes::capsule(0.5f, 3.0f, 16, 12);
+  skeleton::ContractionOptions o;
+  o.max_iterations = 1;
+  const auto r = skeleton::contract(capsule, nullptr, o);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_EQ(r.stop_reason, "iteration cap");
+  ASSERT_EQ(r.warnings.size(), 1u);
+  using Edit = void (*)(skeleton::ContractionOptions&);
+  for (Edit bad : {+[](skeleton::ContractionOptions& x) { x.wl_scale = 0; },
+                   +[](skeleton::ContractionOptions& x) { x.sl = 0.5; },
+                   +[](skeleton::ContractionOptions& x) { x.max_iterations = 0; },
+                   +[](skeleton::ContractionOptions& x) { x.wc = -1; }}) {
+    skeleton::ContractionOptions b;
+    bad(b);
+    EXPECT_THROW(skeleton::contract(capsule, nullptr, b), InputError);
   }
 }

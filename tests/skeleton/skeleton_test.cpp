@@ -212,3 +212,43 @@ TEST(Skeleton, JsonAndObjCarryNodesEdgesAndSheets) {
   EXPECT_EQ(l, s.edges.size());
   EXPECT_EQ(f, s.sheet_triangles.size());
 }
+
+namespace {
+// Forwards to the Embree reference and counts the calls: the contraction must keep one session
+// (set_mesh once) and move its vertices (update_positions) before every later SDF.
+class CountingBackend final : public SdfBackend {
+public:
+  std::string name() const override { return "counting"; }
+  std::string device_name() const override { return inner.device_name(); }
+  void set_mesh(const Mesh& m) override { ++set_mesh_calls, inner.set_mesh(m); }
+  void update_positions(std::span<const glm::vec3> p) override {
+    ++update_calls, inner.update_positions(p);
+  }
+  RawSdf compute(const SdfQuery& q, const SdfOptions& o) override {
+    ++compute_calls;
+    return inner.compute(q, o);
+  }
+  reference::EmbreeBackend inner;
+  int set_mesh_calls = 0, update_calls = 0, compute_calls = 0;
+};
+}  // namespace
+
+TEST(SkeletonContraction, RecomputesTheSdfOnTheContractingMeshInOneSession) {
+  const Mesh mesh = shapes::capsule(0.5f, 3.0f, 16, 12);
+  CountingBackend backend;
+  const sk::ContractionResult r = sk::contract(mesh, &backend, {});
+  ASSERT_GE(r.iterations, 3);
+  EXPECT_EQ(backend.set_mesh_calls, 1);
+  // One SDF per iteration (a rejected last step also measured its SDF first).
+  EXPECT_GE(backend.compute_calls, r.iterations);
+  EXPECT_LE(backend.compute_calls, r.iterations + 1);
+  EXPECT_EQ(backend.update_calls, backend.compute_calls - 1);
+  ASSERT_EQ(r.first_sdf.size(), mesh.positions.size());
+  ASSERT_EQ(r.last_sdf.size(), mesh.positions.size());
+  // The capsule's SDF is about its diameter; the contracted mesh is far thinner.
+  std::vector<float> first = r.first_sdf, last = r.last_sdf;
+  std::nth_element(first.begin(), first.begin() + first.size() / 2, first.end());
+  std::nth_element(last.begin(), last.begin() + last.size() / 2, last.end());
+  EXPECT_NEAR(first[first.size() / 2], 1.0f, 0.15f);
+  EXPECT_LT(last[last.size() / 2], 0.2f * first[first.size() / 2]);
+}
