@@ -157,3 +157,21 @@ TEST(SkeletonContraction, IterationCapAndBadOptions) {
     EXPECT_THROW(skeleton::contract(capsule, nullptr, b), InputError);
   }
 }
+
+TEST(SkeletonWithoutSdf, CapsuleGivesAPathOnItsAxis) {
+  // No backend: plain Au contraction, centre points from one inward ray, radii from distances.
+  const Mesh capsule = shapes::capsule(0.5f, 4.0f, 24, 24);
+  const skeleton::Skeleton s = skeleton::extract(capsule, nullptr, {}, {});
+  ASSERT_GE(s.nodes.size(), 2u);
+  EXPECT_EQ(s.edges.size(), s.nodes.size() - 1);
+  EXPECT_EQ(skeleton::cycle_count(s), 0);
+  std::size_t vertices = 0;
+  for (const skeleton::Node& n : s.nodes) {
+    vertices += n.vertices.size();
+    EXPECT_LT(std::hypot(n.position.x, n.position.y), 0.1f);
+    EXPECT_GT(n.radius, 0.2f);
+    EXPECT_LT(n.radius, 0.8f);
+  }
+  EXPECT_EQ(vertices, capsule.positions.size());
+  EXPECT_DOUBLE_EQ(s.reliability, 1.0);
+}
