@@ -145,8 +145,15 @@ bool TriangleBvh::inside(const glm::vec3& p) const {
                                     glm::normalize(glm::vec3(0.1253f, -0.7731f, 0.6218f))};
   int votes = 0;
   for (const glm::vec3& d : dirs) {
-    const Hit h = closest(p, d, 0.0f, std::numeric_limits<float>::max());
-    if (h.found && glm::dot(normals_[h.face], d) > 0.0f) ++votes;
+    int crossings = 0;
+    float tmax = std::numeric_limits<float>::max();
+    traverse(p, d, 0.0f, tmax, [&](std::uint32_t f) {
+      const Triangle& t = mesh_->triangles[f];
+      crossings += intersect(p, d, mesh_->positions[t[0]], mesh_->positions[t[1]],
+                             mesh_->positions[t[2]]) > 0.0f;
+      return false;
+    });
+    votes += crossings % 2;
   }
   return votes >= 2;
 }

@@ -27,8 +27,10 @@ public:
   // True when the open segment a -> b crosses a triangle (faces using skip_vertex ignored).
   bool segment_blocked(const glm::vec3& a, const glm::vec3& b,
                        std::uint32_t skip_vertex = UINT32_MAX) const;
-  // Inside test for a closed, outward-oriented mesh: the majority vote of three rays in fixed
-  // skew directions, each inside when its closest hit faces away from the point.
+  // Inside test for a closed mesh: the majority vote of three rays in fixed skew directions,
+  // each inside when it crosses the surface an odd number of times. (Parity, not the
+  // orientation of the closest hit: CGAL's cow has a region where the closest-hit test called
+  // a point inside that the winding number puts outside.)
   bool inside(const glm::vec3& p) const;
 
   const Mesh& mesh() const { return *mesh_; }

@@ -17,8 +17,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <map>
+#include <optional>
 #include <numeric>
 #include <set>
 
@@ -34,27 +36,32 @@ struct Surface {
   std::vector<double> weight;      // one-ring areas (refinement weights)
   std::vector<glm::vec3> centre;   // per vertex: a point inside the solid seen from the vertex
   std::vector<float> sdf;          // per vertex SDF of the original (may be empty)
+  std::vector<std::vector<glm::vec3>> incident_normals;  // per vertex: its faces' normals
+  float far = 0.0f;                // a length beyond the model (2 x bbox diagonal)
 
   Surface(const Mesh& o, const Mesh& c, const std::vector<float>& s)
       : original(o), contracted(c), bvh(o), normals(vertex_normals(o)),
         weight(detail::one_ring_areas(o)), sdf(s) {
-    // Centre points: with an SDF, u - SDF/2 * n, kept when the vertex sees it inside the solid;
+    const std::vector<glm::vec3> face_n = face_normals(o);
+    incident_normals.resize(o.positions.size());
+    for (std::size_t f = 0; f < o.triangles.size(); ++f)
+      for (std::uint32_t v : o.triangles[f])
+        if (face_n[f] != glm::vec3(0.0f)) incident_normals[v].push_back(face_n[f]);
+    far = 2.0f * bounding_box(o.positions).diagonal();
+    // Centre points: with an SDF, u - SDF/2 * n when the vertex sees it inside the solid;
     // otherwise (no SDF, or a vertex on a sharp edge whose cone estimate points past a
-    // concavity) half way along the inward normal to the first surface it meets.
+    // concavity) an inside point the vertex sees (see seen_inside_point).
     centre.resize(o.positions.size());
-    const float far = 2.0f * bounding_box(o.positions).diagonal();
     for (std::uint32_t k = 0; k < o.positions.size(); ++k) {
-      const glm::vec3 u = o.positions[k], n = normals[k];
+      const glm::vec3 u = o.positions[k];
       if (!sdf.empty()) {
-        const glm::vec3 p = u - 0.5f * sdf[k] * n;
+        const glm::vec3 p = u - 0.5f * sdf[k] * normals[k];
         if (!bvh.segment_blocked(u, p, k) && bvh.inside(p)) {
           centre[k] = p;
           continue;
         }
       }
-      const auto hit = bvh.closest(u, -n, 0.0f, far, k);
-      const float depth = hit.found ? hit.t : (sdf.empty() ? 0.0f : sdf[k]);
-      centre[k] = u - 0.5f * depth * n;
+      centre[k] = seen_inside_point(k, {u - normals[k], c.positions[k]}).value_or(c.positions[k]);
     }
   }
 
@@ -62,24 +69,41 @@ struct Surface {
     return !bvh.segment_blocked(original.positions[k], p, k);
   }
 
+  // A point inside the solid that vertex k sees: half way from the vertex to the first surface
+  // met toward each target in turn, then along each incident face's inward normal, the first
+  // that is inside. A vertex on a sharp edge can graze the surface toward one target, and
+  // where normals fold (CGAL's cow) the vertex normal can point out of the solid. None where
+  // no such point is found (a vertex on a zero-thickness fin: one on CGAL's cow).
+  std::optional<glm::vec3> seen_inside_point(std::uint32_t k,
+                                             std::initializer_list<glm::vec3> targets) const {
+    const glm::vec3 u = original.positions[k];
+    auto try_direction = [&](glm::vec3 d, glm::vec3& out) {
+      const float len = glm::length(d);
+      if (!(len > 0.0f)) return false;
+      d /= len;
+      const auto hit = bvh.closest(u, d, 0.0f, far, k);
+      if (!hit.found) return false;
+      const glm::vec3 p = u + 0.5f * hit.t * d;
+      if (!bvh.inside(p) || !sees(k, p)) return false;
+      out = p;
+      return true;
+    };
+    glm::vec3 p;
+    for (const glm::vec3& t : targets)
+      if (try_direction(t - u, p)) return p;
+    for (const glm::vec3& fn : incident_normals[k])
+      if (try_direction(-fn, p)) return p;
+    return std::nullopt;
+  }
+
   // A point inside the solid that vertex k sees, for a sheet node: the contracted position if
-  // that works, else half way to the first surface met on the way from the vertex toward the
-  // contracted position, toward its centre point, or along the inward normal (a vertex on a
-  // sharp edge can graze the surface on one of these), whichever first gives an inside point.
-  glm::vec3 sheet_point(std::uint32_t k) const {
+  // that works, else the centre point, else seen_inside_point toward the contracted position
+  // and along -n; none when there is no such point.
+  std::optional<glm::vec3> sheet_point(std::uint32_t k) const {
     const glm::vec3 u = original.positions[k], v = contracted.positions[k];
     if (bvh.inside(v) && sees(k, v)) return v;
-    const float far = 2.0f * bounding_box(original.positions).diagonal();
-    for (const glm::vec3& target : {v, centre[k], u - normals[k]}) {
-      const glm::vec3 d = target - u;
-      const float len = glm::length(d);
-      if (!(len > 0.0f)) continue;
-      const auto hit = bvh.closest(u, d / len, 0.0f, far, k);
-      if (!hit.found) continue;
-      const glm::vec3 p = u + (0.5f * hit.t / len) * d;
-      if (bvh.inside(p) && sees(k, p)) return p;
-    }
-    return centre[k];
+    if (bvh.inside(centre[k]) && sees(k, centre[k])) return centre[k];
+    return seen_inside_point(k, {v, u - normals[k]});
   }
 
   // A node's position (embedding refinement): the mean of its vertices' centre points, i.e.
@@ -106,15 +130,16 @@ struct Surface {
       if (total > 0.0) candidates.push_back(contracted_position + glm::vec3(offset / total));
     }
     candidates.push_back(contracted_position);
+    // Last resorts: the centre points of the vertices, closest to the contracted position first.
+    std::vector<std::pair<float, std::uint32_t>> by_distance;
+    for (std::uint32_t k : members)
+      by_distance.push_back({glm::length(original.positions[k] - contracted_position), k});
+    std::sort(by_distance.begin(), by_distance.end());
+    for (std::size_t i = 0; i < std::min<std::size_t>(by_distance.size(), 16); ++i)
+      candidates.push_back(centre[by_distance[i].second]);
     for (const glm::vec3& c : candidates)
       if (bvh.inside(c)) return c;
-    std::uint32_t best = members.front();
-    float best_d = std::numeric_limits<float>::max();
-    for (std::uint32_t k : members) {
-      const float d = glm::length(original.positions[k] - contracted_position);
-      if (d < best_d) best_d = d, best = k;
-    }
-    return centre[best];
+    return contracted_position;  // nothing inside: degenerate geometry (zero-thickness parts)
   }
 
   // A node's radius: the mean SDF/2 of its vertices, or without an SDF the mean distance from
@@ -139,7 +164,7 @@ void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in
   std::vector<glm::vec3> point(in_sheet.size());
   for (std::uint32_t k = 0; k < in_sheet.size(); ++k) {
     if (!in_sheet[k]) continue;
-    point[k] = surface.sheet_point(k);
+    point[k] = *surface.sheet_point(k);  // in_sheet only holds vertices that have one
     std::array<std::int64_t, 3> key{static_cast<std::int64_t>(k), 0, 0};
     if (spacing > 0.0)
       for (int a = 0; a < 3; ++a) key[a] = static_cast<std::int64_t>(std::floor(point[k][a] / spacing));
@@ -278,7 +303,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
       ++failing;
       // Sheets: the vertex leaves its curve node and becomes a sheet node (below). Curve nodes
       // keep their positions, so no other vertex's visibility changes.
-      if (options.sheets) {
+      if (options.sheets && surface.sheet_point(k)) {
         in_sheet[k] = 1;
         std::erase(members[owner[k]], k);
       }

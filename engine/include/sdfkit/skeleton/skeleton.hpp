@@ -113,7 +113,8 @@ struct Skeleton {
   std::vector<Triangle> sheet_triangles;            // sheet patches, indices into nodes
   // Share of surface vertices whose node is visible from them along a segment inside the solid
   // (a vertex that cannot see its node is first moved to the nearest node it sees; with sheets
-  // on, the vertices that see no curve node become sheet nodes, so this is 1).
+  // on, the vertices that see no curve node become sheet nodes, so this is 1 except for
+  // vertices that see no interior point at all: zero-thickness fins, one vertex of CGAL's cow).
   double reliability = 0.0;
   double curve_reliability = 0.0;  // the same for the curve skeleton before sheets were added
   int iterations = 0;              // contraction iterations
