@@ -47,8 +47,9 @@ struct ContractionOptions {
   // contraction scales with r^2 / h^2: dividing by the mean face area (in diag^2) makes the
   // iteration count independent of units and resolution. Measured on CGAL's elephant with the
   // SDF term: wl_scale 1e-3 -> 13 iterations, 1e-4 -> 17; Au's literal value (in diag units)
-  // needed over 20. 1e-3 collapses the coarse test capsule (842 vertices) to a point in the
-  // first step, so the default is 1e-4.
+  // needed over 20. 1e-3 is faster but coarser: the star test's mean node distance to the
+  // medial axis is 0.0088 against 0.0016 at 1e-4, and CGAL's camel stops after 2 iterations
+  // (a step grew the area), so the default is 1e-4.
   double wl_scale = 1e-4;
   double sl = 2.0;   // W_L is multiplied by sl after every iteration (Au: S_L = 2)
   double wh0 = 1.0;  // initial holding weight W_H0 for every vertex
