@@ -324,6 +324,30 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
     node.radius = surface.radius(node.position, node.vertices);
     sk.nodes.push_back(std::move(node));
   }
+  // A curve node left without vertices merges into its nearest graph neighbour (chains of
+  // such nodes follow), so dropping it does not cut the curve; each merged group holds at
+  // most one node with vertices, because every empty node makes exactly one merge.
+  {
+    std::vector<std::uint32_t> group(curve_nodes);
+    std::iota(group.begin(), group.end(), 0u);
+    auto find = [&](std::uint32_t x) {
+      while (group[x] != x) x = group[x] = group[group[x]];
+      return x;
+    };
+    for (std::uint32_t c = 0; c < curve_nodes; ++c) {
+      if (!members[c].empty() || graph_adjacency[c].empty()) continue;
+      std::uint32_t nearest = graph_adjacency[c].front();
+      for (std::uint32_t d : graph_adjacency[c])
+        if (glm::length(position[d] - position[c]) < glm::length(position[nearest] - position[c]))
+          nearest = d;
+      group[find(c)] = find(nearest);
+    }
+    std::vector<std::uint32_t> kept(curve_nodes, UINT32_MAX);
+    for (std::uint32_t c = 0; c < curve_nodes; ++c)
+      if (!members[c].empty()) kept[find(c)] = node_of_curve[c];
+    for (std::uint32_t c = 0; c < curve_nodes; ++c)
+      if (members[c].empty()) node_of_curve[c] = kept[find(c)];
+  }
   std::vector<std::uint32_t> node_of_vertex(n, UINT32_MAX);
   for (std::uint32_t k = 0; k < n; ++k)
     if (!in_sheet[k]) node_of_vertex[k] = node_of_curve[owner[k]];

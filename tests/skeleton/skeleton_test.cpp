@@ -80,6 +80,21 @@ void expect_partition_and_inside(const Mesh& mesh, const sk::Skeleton& s) {
   }
 }
 
+// Connected parts of the skeleton (curve edges and sheet triangles).
+int parts(const sk::Skeleton& s) {
+  std::vector<std::uint32_t> p(s.nodes.size());
+  std::iota(p.begin(), p.end(), 0u);
+  auto find = [&](std::uint32_t x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+  };
+  for (const auto& e : s.edges) p[find(e[0])] = find(e[1]);
+  for (const Triangle& t : s.sheet_triangles) p[find(t[0])] = find(t[1]), p[find(t[1])] = find(t[2]);
+  int count = 0;
+  for (std::uint32_t i = 0; i < p.size(); ++i) count += find(i) == i;
+  return count;
+}
+
 double mean_distance(const sk::Skeleton& s, const std::vector<models::Segment>& axis) {
   double sum = 0.0;
   for (const sk::Node& n : s.nodes) sum += models::distance_to(axis, n.position);
@@ -96,6 +111,7 @@ TEST(Skeleton, CapsuleGivesOneCurveNearItsAxis) {
   ASSERT_GE(s.nodes.size(), 2u);
   EXPECT_EQ(s.edges.size(), s.nodes.size() - 1);  // a tree ...
   EXPECT_EQ(sk::cycle_count(s), 0);
+  EXPECT_EQ(parts(s), 1);
   EXPECT_EQ(count_degree(s, 1), 2);               // ... with two ends: one curve
   EXPECT_EQ(count_degree(s, 2), static_cast<int>(s.nodes.size()) - 2);
   EXPECT_TRUE(s.sheet_triangles.empty());
@@ -123,6 +139,7 @@ TEST(Skeleton, Genus2GivesTwoCycles) {
   const sk::Skeleton s = run(g.mesh, true, false);
   expect_partition_and_inside(g.mesh, s);
   EXPECT_EQ(sk::cycle_count(s), 2);
+  EXPECT_EQ(parts(s), 1);
   EXPECT_TRUE(s.sheet_triangles.empty());
 }
 
@@ -161,6 +178,8 @@ TEST(Skeleton, SheetsMakeTheCAndSShapesFullyReliable) {
     EXPECT_LT(curves.reliability, 0.9);  // a curve cannot serve a non-convex cross-section
     EXPECT_DOUBLE_EQ(sheets.reliability, 1.0);
     EXPECT_FALSE(sheets.sheet_triangles.empty());
+    EXPECT_EQ(parts(curves), 1);
+    EXPECT_EQ(parts(sheets), 1);  // curve and sheet are joined where they touch
     expect_partition_and_inside(plate.mesh, sheets);
   }
 }
@@ -185,6 +204,7 @@ TEST(Skeleton, SeveralComponentsGiveOnePartEach) {
   const sk::Skeleton s = run(a, true, false);
   expect_partition_and_inside(a, s);
   EXPECT_EQ(sk::cycle_count(s), 1);  // the torus' cycle; the capsule's tree adds none
+  EXPECT_EQ(parts(s), 2);
   for (const sk::Node& n : s.nodes) {
     const bool first = n.vertices.front() < offset;
     for (std::uint32_t v : n.vertices) EXPECT_EQ(v < offset, first);  // no node spans both
