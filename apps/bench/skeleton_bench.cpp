@@ -86,6 +86,7 @@ SdfkitRun run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend) {
   if (const char* v = std::getenv("SDFKIT_BENCH_SDF_TERM")) co.sdf_term = std::atoi(v) != 0;
   if (const char* v = std::getenv("SDFKIT_BENCH_ITERATIONS")) co.max_iterations = std::atoi(v);
   if (const char* v = std::getenv("SDFKIT_BENCH_SL")) co.sl = std::atof(v);
+  if (const char* v = std::getenv("SDFKIT_BENCH_STALL")) co.stall_ratio = std::atof(v);
   const sk::SkeletonOptions so;
   const auto t0 = std::chrono::steady_clock::now();
   const sk::ContractionResult c = sk::contract(mesh, &backend, co);

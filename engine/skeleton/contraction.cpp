@@ -149,6 +149,7 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
       break;
     }
     const double solve_ms = ms_since(t_solve);
+    const double previous_ratio = result.area_ratio;
     Mesh candidate = current;
     for (std::size_t i = 0; i < n; ++i)
       candidate.positions[i] = glm::vec3(next(static_cast<Eigen::Index>(i), 0),
@@ -174,7 +175,11 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
       break;
     }
 
-    wl *= options.sl;
+    // A step that shrank the area by less than stall_ratio is a stall (typically thin parts
+    // held by the SDF weights while W_L catches up): W_L then grows by sl^2.
+    wl *= previous_ratio - result.area_ratio < options.stall_ratio * previous_ratio
+              ? options.sl * options.sl
+              : options.sl;
     for (std::size_t i = 0; i < n; ++i) {
       const double growth = area[i] > 0.0 ? std::sqrt(area0[i] / area[i]) : kMaxHoldingGrowth;
       wh[i] = options.wh0 * std::min(growth, kMaxHoldingGrowth);

@@ -51,7 +51,10 @@ struct ContractionOptions {
   // medial axis is 0.0088 against 0.0016 at 1e-4, and CGAL's camel stops after 2 iterations
   // (a step grew the area), so the default is 1e-4.
   double wl_scale = 1e-4;
-  double sl = 2.0;   // W_L is multiplied by sl after every iteration (Au: S_L = 2)
+  double sl = 2.0;   // W_L is multiplied by sl after every iteration (Au: S_L = 2) ...
+  // ... or by sl^2 after an iteration that shrank the total area by less than this fraction
+  // (0 = never): a stall while thin parts, held by the SDF weights, wait for W_L.
+  double stall_ratio = 0.0;
   double wh0 = 1.0;  // initial holding weight W_H0 for every vertex
   // Weight of the SDF centering term: attraction of v_i to C_i = v_i - SDF_i/2 * n_i, where
   // SDF_i is the smallest SDF measured at vertex i so far (contraction only thins the shape;
