@@ -1,0 +1,200 @@
+// Mesh contraction (Au et al. 2008) with the SDF centering term and SDF holding weights
+// (Shapira et al. 2008, section 5).
+
+#include "sdfkit/skeleton/skeleton.hpp"
+
+#include "laplacian.hpp"
+#include "validate.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace sdfkit::skeleton {
+namespace {
+
+// Holding weights grow as sqrt(A0 / At); the growth is capped so that a fully collapsed
+// one-ring (At -> 0) stays a finite, well-conditioned constraint.
+constexpr double kMaxHoldingGrowth = 1e4;
+// A contraction step must not grow the surface area by more than this factor; one that does is
+// diverging (ill-conditioned system), so the loop stops with the state before it.
+constexpr double kMaxAreaGrowth = 1.25;
+
+void validate(const ContractionOptions& o) {
+  auto bad = [](const std::string& what) { throw InputError("contraction option " + what); };
+  if (!(o.wl_scale > 0.0) || !std::isfinite(o.wl_scale)) bad("wl_scale must be positive");
+  if (!(o.sl >= 1.0) || !std::isfinite(o.sl)) bad("sl (contraction growth) must be at least 1");
+  if (!(o.wh0 > 0.0) || !std::isfinite(o.wh0)) bad("wh0 (holding weight) must be positive");
+  if (!(o.wc >= 0.0) || !std::isfinite(o.wc)) bad("wc (SDF centering weight) must be >= 0");
+  if (!(o.sdf_bias > 0.0 && o.sdf_bias <= 1.0)) bad("sdf_bias must be in (0, 1]");
+  if (!(o.area_ratio_stop >= 0.0 && o.area_ratio_stop < 1.0)) bad("area_ratio_stop must be in [0, 1)");
+  if (o.max_iterations < 1 || o.max_iterations > 1000) bad("max_iterations must be in [1, 1000]");
+  validate_options(o.sdf);
+}
+
+double total(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
+
+bool all_finite(const Eigen::MatrixXd& m) { return m.allFinite(); }
+
+}  // namespace
+
+ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& options) {
+  validate(options);
+  detail::require_closed(mesh, "skeleton extraction");
+  ContractionResult result;
+  result.contracted = mesh;
+  const bool use_sdf = options.sdf_term && backend != nullptr;
+  SdfOptions sdf_options = options.sdf;
+  sdf_options.domain = SdfDomain::Vertex;
+
+  const std::size_t n = mesh.positions.size();
+  const double diag = bounding_box(mesh.positions).diagonal();
+  const std::vector<double> area0 = detail::one_ring_areas(mesh);
+  const double total0 = total(area0);
+  const double mean_face_area = total0 / 3.0 / static_cast<double>(mesh.triangles.size());
+  // Dimensionless W_L0 (see the header): wl_scale over the mean face area measured in diag^2.
+  double wl = options.wl_scale * (diag * diag) / mean_face_area;
+  std::vector<double> wh(n, options.wh0);
+
+  if (use_sdf) backend->set_mesh(mesh);
+  Eigen::MatrixXd V(static_cast<Eigen::Index>(n), 3);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) V(static_cast<Eigen::Index>(i), k) = mesh.positions[i][k];
+
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+  std::vector<float> thickness;  // per vertex: the smallest SDF measured so far
+  Eigen::Index pattern_nonzeros = 0;
+  double factor_ms = 0.0;
+  using Clock = std::chrono::steady_clock;
+  auto ms_since = [](Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+  };
+  for (int it = 0; it < options.max_iterations; ++it) {
+    Mesh& current = result.contracted;
+    const auto t_sdf = Clock::now();
+    Eigen::MatrixXd C;
+    if (use_sdf) {
+      if (it > 0) backend->update_positions(current.positions);
+      const SdfField field = compute_sdf(*backend, current, sdf_options);
+      if (it == 0) {
+        result.first_sdf = field.values;
+        thickness = field.values;
+      }
+      result.last_sdf = field.values;
+      // Contraction only thins the shape, so a vertex's SDF never grows: on the crumpled,
+      // partly collapsed mesh of later iterations some rays escape through folds and measure
+      // far surfaces; those values would pull vertices outward (C_i) and, through the
+      // normalization, make every other vertex look thin and hold it (measured on CGAL's
+      // elephant: the area grew from 0.28 to 0.40 of the original over five iterations).
+      for (std::size_t i = 0; i < n; ++i) thickness[i] = std::min(thickness[i], field.values[i]);
+      const std::vector<glm::vec3> normals = vertex_normals(current);
+      C = V;
+      for (std::size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k)
+          C(static_cast<Eigen::Index>(i), k) -= 0.5 * thickness[i] * normals[i][k];
+      if (it > 0) {
+        const std::vector<float> norm = normalized(
+            options.holding_sdf == HoldingSdf::Initial ? result.first_sdf : thickness);
+        for (std::size_t i = 0; i < n; ++i)
+          wh[i] /= norm[i] * (1.0 - options.sdf_bias) + options.sdf_bias;
+      }
+    }
+
+    const double sdf_ms = ms_since(t_sdf);
+    const auto t_solve = Clock::now();
+    const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(current);
+    Eigen::SparseMatrix<double> A = (wl * wl) * (L * L);  // L is symmetric: L^T L = L L
+    Eigen::VectorXd diagonal(static_cast<Eigen::Index>(n));
+    Eigen::MatrixXd rhs(static_cast<Eigen::Index>(n), 3);
+    const double wc2 = use_sdf ? options.wc * options.wc : 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      const double wh2 = wh[i] * wh[i];
+      diagonal(r) = wh2 + wc2;
+      rhs.row(r) = wh2 * V.row(r);
+      if (use_sdf) rhs.row(r) += wc2 * C.row(r);
+    }
+    for (Eigen::Index r = 0; r < A.outerSize(); ++r) A.coeffRef(r, r) += diagonal(r);
+
+    // The sparsity pattern depends only on the connectivity (every edge is stored, also with
+    // weight 0), so the fill-reducing ordering and symbolic analysis are done once. (Measured
+    // on refined_elephant, 44k vertices: factorization ~0.28 s CPU per iteration; the
+    // quasi-definite augmented system [-I, L; L, D/W_L^2] has the same fill and cost.)
+    const double build_ms = ms_since(t_solve);
+    if (it == 0 || A.nonZeros() != pattern_nonzeros) {
+      solver.analyzePattern(A);
+      pattern_nonzeros = A.nonZeros();
+    }
+    solver.factorize(A);
+    factor_ms = ms_since(t_solve) - build_ms;
+    if (solver.info() != Eigen::Success) {
+      result.warnings.push_back("contraction stopped after " + std::to_string(it) +
+                                " iterations: the sparse factorization failed; the last good "
+                                "state is kept");
+      result.stop_reason = "factorization failed";
+      break;
+    }
+    const Eigen::MatrixXd next = solver.solve(rhs);
+    if (solver.info() != Eigen::Success || !all_finite(next)) {
+      result.warnings.push_back("contraction stopped after " + std::to_string(it) +
+                                " iterations: the solve gave non-finite positions; the last "
+                                "good state is kept");
+      break;
+    }
+    const double solve_ms = ms_since(t_solve);
+    const double previous_ratio = result.area_ratio;
+    Mesh candidate = current;
+    for (std::size_t i = 0; i < n; ++i)
+      candidate.positions[i] = glm::vec3(next(static_cast<Eigen::Index>(i), 0),
+                                         next(static_cast<Eigen::Index>(i), 1),
+                                         next(static_cast<Eigen::Index>(i), 2));
+    const std::vector<double> area = detail::one_ring_areas(candidate);
+    const double ratio = total0 > 0.0 ? total(area) / total0 : 0.0;
+    if (ratio > kMaxAreaGrowth * result.area_ratio) {
+      result.stop_reason = "the area stopped shrinking (ratio " + std::to_string(result.area_ratio) +
+                           ", next step " + std::to_string(ratio) + "); the last state is kept";
+      break;
+    }
+    V = next;
+    current = std::move(candidate);
+    result.iterations = it + 1;
+    result.area_ratio = ratio;
+    log_debug("contraction iteration " + std::to_string(it + 1) + ": area ratio " +
+              std::to_string(result.area_ratio) + ", SDF " + std::to_string(sdf_ms) +
+              " ms, solve " + std::to_string(solve_ms) + " ms (factorization " +
+              std::to_string(factor_ms) + " ms)");
+    if (result.area_ratio < options.area_ratio_stop) {
+      result.stop_reason = "area ratio below " + std::to_string(options.area_ratio_stop);
+      break;
+    }
+
+    // A step that shrank the area by less than stall_ratio is a stall (typically thin parts
+    // held by the SDF weights while W_L catches up): W_L then grows by sl^2.
+    wl *= previous_ratio - result.area_ratio < options.stall_ratio * previous_ratio
+              ? options.sl * options.sl
+              : options.sl;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double growth = area[i] > 0.0 ? std::sqrt(area0[i] / area[i]) : kMaxHoldingGrowth;
+      wh[i] = options.wh0 * std::min(growth, kMaxHoldingGrowth);
+    }
+  }
+  if (result.iterations == options.max_iterations && result.area_ratio >= options.area_ratio_stop) {
+    result.stop_reason = "iteration cap";
+    result.warnings.push_back("contraction reached the iteration cap (" +
+                              std::to_string(options.max_iterations) + ") at area ratio " +
+                              std::to_string(result.area_ratio));
+  }
+  if (result.stop_reason.empty()) result.stop_reason = "stopped early (see warnings)";
+  log_info("contraction: " + std::to_string(result.iterations) + " iterations, " + result.stop_reason);
+  for (const std::string& w : result.warnings) log_warning(w);
+  return result;
+}
+
+}  // namespace sdfkit::skeleton

@@ -1,0 +1,296 @@
+// Skeletons of shapes with a known medial axis and topology, computed with the Embree reference
+// as the SDF backend (recomputed at every contraction iteration).
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/io/asset.hpp"
+#include "sdfkit/reference/embree_backend.hpp"
+#include "sdfkit/skeleton/models.hpp"
+#include "sdfkit/skeleton/skeleton.hpp"
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "analytic.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <sstream>
+
+using namespace sdfkit;
+namespace sk = sdfkit::skeleton;
+namespace models = sdfkit::skeleton::models;
+
+namespace {
+
+sk::Skeleton run(const Mesh& mesh, bool sdf_term, bool sheets) {
+  reference::EmbreeBackend backend;
+  sk::ContractionOptions co;
+  co.sdf_term = sdf_term;
+  sk::SkeletonOptions so;
+  so.sheets = sheets;
+  return sk::extract(mesh, &backend, co, so);
+}
+
+std::vector<int> degrees(const sk::Skeleton& s) {
+  std::vector<int> d(s.nodes.size(), 0);
+  for (const auto& e : s.edges) ++d[e[0]], ++d[e[1]];
+  return d;
+}
+
+int count_degree(const sk::Skeleton& s, int degree) {
+  const auto d = degrees(s);
+  return static_cast<int>(std::count(d.begin(), d.end(), degree));
+}
+
+// Generalized winding number of a closed mesh at p (solid angles, Van Oosterom & Strackee):
+// independent of the library's ray-based inside test.
+double winding_number(const Mesh& m, const glm::vec3& p) {
+  double total = 0.0;
+  for (const Triangle& t : m.triangles) {
+    const glm::dvec3 a = glm::dvec3(m.positions[t[0]]) - glm::dvec3(p);
+    const glm::dvec3 b = glm::dvec3(m.positions[t[1]]) - glm::dvec3(p);
+    const glm::dvec3 c = glm::dvec3(m.positions[t[2]]) - glm::dvec3(p);
+    const double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+    const double num = glm::dot(a, glm::cross(b, c));
+    const double den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(b, c) * la + glm::dot(c, a) * lb;
+    total += 2.0 * std::atan2(num, den);
+  }
+  return total / (4.0 * M_PI);
+}
+
+// Every input vertex in exactly one node; every node inside the solid.
+void expect_partition_and_inside(const Mesh& mesh, const sk::Skeleton& s) {
+  std::vector<int> count(mesh.positions.size(), 0);
+  for (const sk::Node& n : s.nodes) {
+    EXPECT_FALSE(n.vertices.empty());
+    for (std::uint32_t v : n.vertices) ++count[v];
+    EXPECT_GT(winding_number(mesh, n.position), 0.5)
+        << "node at " << n.position.x << ' ' << n.position.y << ' ' << n.position.z;
+    EXPECT_TRUE(std::isfinite(n.radius));
+    EXPECT_GT(n.radius, 0.0f);
+  }
+  for (int c : count) ASSERT_EQ(c, 1);
+  for (const auto& e : s.edges) {
+    ASSERT_LT(e[0], e[1]);
+    ASSERT_LT(e[1], s.nodes.size());
+  }
+}
+
+// Connected parts of the skeleton (curve edges and sheet triangles).
+int parts(const sk::Skeleton& s) {
+  std::vector<std::uint32_t> p(s.nodes.size());
+  std::iota(p.begin(), p.end(), 0u);
+  auto find = [&](std::uint32_t x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+  };
+  for (const auto& e : s.edges) p[find(e[0])] = find(e[1]);
+  for (const Triangle& t : s.sheet_triangles) p[find(t[0])] = find(t[1]), p[find(t[1])] = find(t[2]);
+  int count = 0;
+  for (std::uint32_t i = 0; i < p.size(); ++i) count += find(i) == i;
+  return count;
+}
+
+double mean_distance(const sk::Skeleton& s, const std::vector<models::Segment>& axis) {
+  double sum = 0.0;
+  for (const sk::Node& n : s.nodes) sum += models::distance_to(axis, n.position);
+  return sum / static_cast<double>(s.nodes.size());
+}
+
+}  // namespace
+
+TEST(Skeleton, CapsuleGivesOneCurveNearItsAxis) {
+  const float radius = 0.5f, length = 4.0f;
+  const Mesh mesh = shapes::capsule(radius, length, 24, 24);
+  const sk::Skeleton s = run(mesh, true, true);
+  expect_partition_and_inside(mesh, s);
+  ASSERT_GE(s.nodes.size(), 2u);
+  EXPECT_EQ(s.edges.size(), s.nodes.size() - 1);  // a tree ...
+  EXPECT_EQ(sk::cycle_count(s), 0);
+  EXPECT_EQ(parts(s), 1);
+  EXPECT_EQ(count_degree(s, 1), 2);               // ... with two ends: one curve
+  EXPECT_EQ(count_degree(s, 2), static_cast<int>(s.nodes.size()) - 2);
+  EXPECT_TRUE(s.sheet_triangles.empty());
+  const float total = length + 2.0f * radius;
+  for (const sk::Node& n : s.nodes) {
+    EXPECT_LT(std::hypot(n.position.x, n.position.y), 0.02f * total);
+    EXPECT_LT(std::abs(n.position.z), 0.5f * total);
+    EXPECT_NEAR(n.radius, radius, 0.35f * radius);  // SDF/2 of a tube is its radius (ends: less)
+  }
+  EXPECT_DOUBLE_EQ(s.reliability, 1.0);
+}
+
+TEST(Skeleton, TorusGivesOneCycle) {
+  const Mesh mesh = shapes::torus(2.0f, 0.5f, 48, 16);
+  const sk::Skeleton s = run(mesh, true, true);
+  expect_partition_and_inside(mesh, s);
+  EXPECT_EQ(sk::cycle_count(s), 1);
+  EXPECT_EQ(count_degree(s, 2), static_cast<int>(s.nodes.size()));
+  for (const sk::Node& n : s.nodes)
+    EXPECT_NEAR(std::hypot(n.position.x, n.position.y), 2.0f, 0.1f);
+}
+
+TEST(Skeleton, Genus2GivesTwoCycles) {
+  const auto g = models::genus2();
+  const sk::Skeleton s = run(g.mesh, true, false);
+  expect_partition_and_inside(g.mesh, s);
+  EXPECT_EQ(sk::cycle_count(s), 2);
+  EXPECT_EQ(parts(s), 1);
+  EXPECT_TRUE(s.sheet_triangles.empty());
+}
+
+TEST(Skeleton, StarGivesFiveBranchesFromOneJunction) {
+  const auto star = models::five_armed_star();
+  const sk::Skeleton s = run(star.mesh, true, false);
+  expect_partition_and_inside(star.mesh, s);
+  EXPECT_EQ(sk::cycle_count(s), 0);
+  EXPECT_EQ(count_degree(s, 1), 5);
+  EXPECT_EQ(count_degree(s, 5), 1);
+  EXPECT_EQ(count_degree(s, 1) + count_degree(s, 2) + count_degree(s, 5),
+            static_cast<int>(s.nodes.size()));
+  // The junction sits at the centre of the star, each end near its arm's end.
+  const auto d = degrees(s);
+  for (std::size_t i = 0; i < s.nodes.size(); ++i)
+    if (d[i] == 5) {
+      EXPECT_LT(glm::length(s.nodes[i].position), 0.3f);
+    }
+}
+
+TEST(Skeleton, SdfTermBringsNodesCloserToTheMedialAxis) {
+  const auto star = models::five_armed_star();
+  const double with = mean_distance(run(star.mesh, true, false), star.axis);
+  const double without = mean_distance(run(star.mesh, false, false), star.axis);
+  std::printf("star: mean node distance to the medial axis: with SDF term %.4f, without %.4f\n",
+              with, without);
+  EXPECT_LT(with, without);
+}
+
+TEST(Skeleton, SheetsMakeTheCAndSShapesFullyReliable) {
+  for (const auto& plate : {models::c_shape(), models::s_shape()}) {
+    const sk::Skeleton curves = run(plate.mesh, true, false);
+    const sk::Skeleton sheets = run(plate.mesh, true, true);
+    std::printf("plate: curve reliability %.3f, with sheets %.3f (%zu sheet triangles)\n",
+                curves.reliability, sheets.reliability, sheets.sheet_triangles.size());
+    EXPECT_LT(curves.reliability, 0.9);  // a curve cannot serve a non-convex cross-section
+    EXPECT_DOUBLE_EQ(sheets.reliability, 1.0);
+    EXPECT_FALSE(sheets.sheet_triangles.empty());
+    EXPECT_EQ(parts(curves), 1);
+    EXPECT_EQ(parts(sheets), 1);  // curve and sheet are joined where they touch
+    expect_partition_and_inside(plate.mesh, sheets);
+  }
+}
+
+TEST(Skeleton, OpenMeshIsRefusedWithAClearError) {
+  Mesh open = shapes::capsule(0.5f, 2.0f, 16, 8);
+  open.triangles.pop_back();
+  try {
+    run(open, true, true);
+    FAIL() << "an open mesh was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("boundary edges"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Skeleton, SeveralComponentsGiveOnePartEach) {
+  Mesh a = shapes::capsule(0.4f, 2.0f, 16, 12);
+  const Mesh b = shapes::torus(1.5f, 0.4f, 32, 12);
+  const auto offset = static_cast<std::uint32_t>(a.positions.size());
+  for (glm::vec3 p : b.positions) a.positions.push_back(p + glm::vec3(5.0f, 0.0f, 0.0f));
+  for (Triangle t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  const sk::Skeleton s = run(a, true, false);
+  expect_partition_and_inside(a, s);
+  EXPECT_EQ(sk::cycle_count(s), 1);  // the torus' cycle; the capsule's tree adds none
+  EXPECT_EQ(parts(s), 2);
+  for (const sk::Node& n : s.nodes) {
+    const bool first = n.vertices.front() < offset;
+    for (std::uint32_t v : n.vertices) EXPECT_EQ(v < offset, first);  // no node spans both
+  }
+  for (const auto& e : s.edges)
+    EXPECT_EQ(s.nodes[e[0]].vertices.front() < offset, s.nodes[e[1]].vertices.front() < offset);
+}
+
+TEST(Skeleton, JsonAndObjCarryNodesEdgesAndSheets) {
+  const auto plate = models::c_shape();
+  const sk::Skeleton s = run(plate.mesh, true, true);
+  const auto j = nlohmann::json::parse(sk::to_json(s));
+  ASSERT_EQ(j["nodes"].size(), s.nodes.size());
+  EXPECT_EQ(j["edges"].size(), s.edges.size());
+  EXPECT_EQ(j["sheet_triangles"].size(), s.sheet_triangles.size());
+  EXPECT_EQ(j["nodes"][0]["vertices"].size(), s.nodes[0].vertices.size());
+  EXPECT_FLOAT_EQ(j["nodes"][0]["position"][0].get<float>(), s.nodes[0].position.x);
+  std::ostringstream obj;
+  sk::write_obj(obj, s);
+  std::size_t v = 0, l = 0, f = 0;
+  std::istringstream in(obj.str());
+  for (std::string line; std::getline(in, line);) {
+    v += line.rfind("v ", 0) == 0;
+    l += line.rfind("l ", 0) == 0;
+    f += line.rfind("f ", 0) == 0;
+  }
+  EXPECT_EQ(v, s.nodes.size());
+  EXPECT_EQ(l, s.edges.size());
+  EXPECT_EQ(f, s.sheet_triangles.size());
+}
+
+namespace {
+// Forwards to the Embree reference and counts the calls: the contraction must keep one session
+// (set_mesh once) and move its vertices (update_positions) before every later SDF.
+class CountingBackend final : public SdfBackend {
+public:
+  std::string name() const override { return "counting"; }
+  std::string device_name() const override { return inner.device_name(); }
+  void set_mesh(const Mesh& m) override { ++set_mesh_calls, inner.set_mesh(m); }
+  void update_positions(std::span<const glm::vec3> p) override {
+    ++update_calls, inner.update_positions(p);
+  }
+  RawSdf compute(const SdfQuery& q, const SdfOptions& o) override {
+    ++compute_calls;
+    return inner.compute(q, o);
+  }
+  reference::EmbreeBackend inner;
+  int set_mesh_calls = 0, update_calls = 0, compute_calls = 0;
+};
+}  // namespace
+
+TEST(SkeletonContraction, RecomputesTheSdfOnTheContractingMeshInOneSession) {
+  const Mesh mesh = shapes::capsule(0.5f, 3.0f, 16, 12);
+  CountingBackend backend;
+  const sk::ContractionResult r = sk::contract(mesh, &backend, {});
+  ASSERT_GE(r.iterations, 3);
+  EXPECT_EQ(backend.set_mesh_calls, 1);
+  // One SDF per iteration (a rejected last step also measured its SDF first).
+  EXPECT_GE(backend.compute_calls, r.iterations);
+  EXPECT_LE(backend.compute_calls, r.iterations + 1);
+  EXPECT_EQ(backend.update_calls, backend.compute_calls - 1);
+  ASSERT_EQ(r.first_sdf.size(), mesh.positions.size());
+  ASSERT_EQ(r.last_sdf.size(), mesh.positions.size());
+  // The capsule's SDF is about its diameter; the contracted mesh is far thinner.
+  std::vector<float> first = r.first_sdf, last = r.last_sdf;
+  std::nth_element(first.begin(), first.begin() + first.size() / 2, first.end());
+  std::nth_element(last.begin(), last.begin() + last.size() / 2, last.end());
+  EXPECT_NEAR(first[first.size() / 2], 1.0f, 0.15f);
+  EXPECT_LT(last[last.size() / 2], 0.2f * first[first.size() / 2]);
+}
+
+TEST(Skeleton, RealMeshesGiveAValidSkeletonOrAClearError) {
+  // CGAL's data: a closed animal, a mesh of degenerate triangles, an open cube.
+  for (const char* name : {"cow.off", "degtri_sliding.off", "cube-ouvert.off"}) {
+    const Mesh mesh = io::load_asset(test::data_mesh(name)).mesh;
+    try {
+      const sk::Skeleton s = run(mesh, true, true);
+      expect_partition_and_inside(mesh, s);
+      // A vertex on a zero-thickness fin sees no interior point at all: not all of them are 1.
+      EXPECT_GT(s.reliability, 0.99) << name;
+      std::printf("%s: %zu nodes, %zu edges, %zu sheet triangles, curve reliability %.4f, "
+                  "reliability %.4f, %d iterations\n", name, s.nodes.size(), s.edges.size(),
+                  s.sheet_triangles.size(), s.curve_reliability, s.reliability, s.iterations);
+    } catch (const InputError& e) {
+      std::printf("%s: %s\n", name, e.what());
+      EXPECT_GT(std::string(e.what()).size(), 20u);
+    }
+  }
+}
