@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <unistd.h>
@@ -84,12 +85,11 @@ int main(int argc, char** argv) {
     }
     std::ostringstream header;
     header << "Machine: " << cpu_name() << ", " << std::thread::hardware_concurrency() << " hardware threads";
+    std::set<std::string> devices;
     for (const auto& r : results)
       for (const auto& b : r.runs)
-        if (b.error.empty() && b.backend != "embree") {
+        if (b.error.empty() && devices.insert(b.backend + " on " + b.device).second)
           header << "; " << b.backend << " on " << b.device;
-          break;
-        }
     header << ".\n\n";
     const std::string md = header.str() + to_markdown(results, o);
     std::printf("%s", md.c_str());
