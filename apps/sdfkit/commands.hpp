@@ -14,6 +14,7 @@ void add_compute_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
 void add_batch_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_skeleton_command(CLI::App& app);
 void add_smooth_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 #ifdef SDFKIT_CLI_HAS_RENDER

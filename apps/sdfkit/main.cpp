@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   sdfkit::cli::add_devices_command(app);
   sdfkit::cli::add_batch_command(app);
   sdfkit::cli::add_bench_command(app);
+  sdfkit::cli::add_skeleton_command(app);
   sdfkit::cli::add_smooth_command(app);
   sdfkit::cli::add_compare_command(app);
 #ifdef SDFKIT_CLI_HAS_RENDER

@@ -312,11 +312,21 @@ private:
         fail(path_, "node " + std::to_string(index) + " uses mesh " + std::to_string(node.mesh) +
                         " which does not exist");
       const tinygltf::Mesh& mesh = m_.meshes[static_cast<std::size_t>(node.mesh)];
-      for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
-        add_primitive(index, node.mesh, static_cast<int>(p), world);
+      if (is_overlay(mesh)) {
+        ++skipped_["sdfkit overlays (" + mesh.name + ")"];
+      } else {
+        for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
+          add_primitive(index, node.mesh, static_cast<int>(p), world);
+      }
     }
     for (int c : node.children) visit(c, world);
     on_path_[i] = 0;
+  }
+
+  // Meshes sdfkit wrote as overlays (a skeleton) are not part of the surface.
+  static bool is_overlay(const tinygltf::Mesh& mesh) {
+    return mesh.extras.IsObject() && mesh.extras.Has("sdfkit_overlay") &&
+           mesh.extras.Get("sdfkit_overlay").IsBool() && mesh.extras.Get("sdfkit_overlay").Get<bool>();
   }
 
   void add_primitive(int node, int mesh_index, int prim_index, const glm::dmat4& world) {

@@ -287,6 +287,8 @@ void add_overlays(tinygltf::Model& model, const std::vector<Overlay>& overlays) 
                                              TINYGLTF_TARGET_ARRAY_BUFFER, true);
     tinygltf::Mesh mesh;
     mesh.name = o.name;
+    // Marked so that sdfkit reading this file back takes only the surface.
+    mesh.extras = tinygltf::Value(tinygltf::Value::Object{{"sdfkit_overlay", tinygltf::Value(true)}});
     if (!o.lines.empty()) {
       tinygltf::Primitive prim;
       prim.mode = TINYGLTF_MODE_LINE;

@@ -58,6 +58,27 @@ TEST(Overlay, SkeletonBecomesANodeWithLinesAndTriangles) {
   EXPECT_EQ(model.accessors.at(static_cast<std::size_t>(mesh.primitives[1].indices)).count, 3u);
 }
 
+TEST(Overlay, ReadingTheFileBackTakesOnlyTheSurface) {
+  const Mesh m = shapes::capsule(0.5f, 3.0f, 16, 6);
+  SdfField f;
+  f.values.assign(m.positions.size(), 1.0f);
+  f.kept_rays.assign(m.positions.size(), 1u);
+  f.filled.assign(m.positions.size(), 0);
+  io::WriteOptions o;
+  io::Overlay skel;
+  skel.name = "skeleton";
+  skel.points = {{0, 0, -1.5f}, {0, 0, 1.5f}, {0.2f, 0, 0}};
+  skel.lines = {{0, 1}};
+  skel.triangles = {{0, 1, 2}};
+  o.overlays.push_back(skel);
+  const fs::path out = fs::temp_directory_path() / "sdfkit_overlay_reread.glb";
+  io::write_field(out.string(), asset_of(m), f, o);
+  const io::Asset back = io::load_asset(out.string());
+  fs::remove(out);
+  EXPECT_EQ(back.input_positions.size(), m.positions.size());
+  EXPECT_EQ(back.input_triangles.size(), m.triangles.size());
+}
+
 TEST(Overlay, IndexOutOfRangeIsAnErrorAndWritesNothing) {
   const Mesh m = shapes::box(1, 1, 1, 1);
   SdfField f;
