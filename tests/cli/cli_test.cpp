@@ -1,6 +1,7 @@
 // Runs the real `sdfkit` binary on real and broken files: every bad input must give exactly one
 // error line naming the file and a non-zero exit, never a crash, and never a written output.
 #include "analytic.hpp"
+#include "run.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,18 +17,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  bool signaled = false;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using RunResult = sdfkit::test::CommandResult;
+using sdfkit::test::slurp;
 
 class Cli : public ::testing::Test {
 protected:
@@ -40,15 +31,7 @@ protected:
   void TearDown() override { fs::remove_all(dir_); }
 
   RunResult run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(SDFKIT_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
+    return sdfkit::test::run_command(std::string(SDFKIT_CLI) + " " + args, dir_);
   }
   fs::path write(const std::string& name, const std::string& content) {
     const fs::path p = dir_ / name;

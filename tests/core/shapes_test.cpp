@@ -1,3 +1,4 @@
+#include "analytic.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/core/topology.hpp"
 
@@ -8,24 +9,15 @@
 
 using namespace sdfkit;
 
-namespace {
-double signed_volume(const Mesh& m) {
-  double v = 0;
-  for (const Triangle& t : m.triangles)
-    v += glm::dot(glm::dvec3(m.positions[t[0]]),
-                  glm::cross(glm::dvec3(m.positions[t[1]]), glm::dvec3(m.positions[t[2]]))) / 6.0;
-  return v;
-}
-}  // namespace
 
 TEST(Shapes, OutwardOrientedWithTheRightVolume) {
   const double pi = M_PI;
-  EXPECT_NEAR(signed_volume(shapes::sphere(2, 96, 48)), 4.0 / 3.0 * pi * 8, 0.01 * 4 / 3. * pi * 8);
-  EXPECT_NEAR(signed_volume(shapes::icosphere(2, 4)), 4.0 / 3.0 * pi * 8, 0.01 * 4 / 3. * pi * 8);
-  EXPECT_NEAR(signed_volume(shapes::capped_cylinder(1, 4, 128, 4, 3)), pi * 4, 0.01 * pi * 4);
-  EXPECT_NEAR(signed_volume(shapes::capsule(1, 2, 96, 4)), pi * 2 + 4.0 / 3 * pi, 0.02 * pi * 3.3);
-  EXPECT_NEAR(signed_volume(shapes::torus(3, 1, 128, 64)), 2 * pi * pi * 3, 0.01 * 2 * pi * pi * 3);
-  EXPECT_NEAR(signed_volume(shapes::box(1, 2, 3, 5)), 6.0, 1e-4);
+  EXPECT_NEAR(test::signed_volume(shapes::sphere(2, 96, 48)), 4.0 / 3.0 * pi * 8, 0.01 * 4 / 3. * pi * 8);
+  EXPECT_NEAR(test::signed_volume(shapes::icosphere(2, 4)), 4.0 / 3.0 * pi * 8, 0.01 * 4 / 3. * pi * 8);
+  EXPECT_NEAR(test::signed_volume(shapes::capped_cylinder(1, 4, 128, 4, 3)), pi * 4, 0.01 * pi * 4);
+  EXPECT_NEAR(test::signed_volume(shapes::capsule(1, 2, 96, 4)), pi * 2 + 4.0 / 3 * pi, 0.02 * pi * 3.3);
+  EXPECT_NEAR(test::signed_volume(shapes::torus(3, 1, 128, 64)), 2 * pi * pi * 3, 0.01 * 2 * pi * pi * 3);
+  EXPECT_NEAR(test::signed_volume(shapes::box(1, 2, 3, 5)), 6.0, 1e-4);
 }
 
 TEST(Shapes, VerticesLieOnTheImplicitSurface) {
@@ -45,7 +37,7 @@ TEST(Shapes, SweptTubeIsClosedAndGrowsFromD0ToD1) {
   EXPECT_EQ(r.boundary_edges, 0u);
   EXPECT_EQ(r.non_manifold_edges, 0u);
   EXPECT_EQ(r.components, 1u);
-  EXPECT_GT(signed_volume(tube.mesh), 0.0);
+  EXPECT_GT(test::signed_volume(tube.mesh), 0.0);
   float lo = 1e9f, hi = 0;
   for (float d : tube.true_diameter) {
     lo = std::min(lo, d);

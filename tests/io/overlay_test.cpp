@@ -23,14 +23,19 @@ io::Asset asset_of(const Mesh& m) {
   for (std::uint32_t i = 0; i < m.positions.size(); ++i) a.input_to_welded.push_back(i);
   return a;
 }
-}  // namespace
 
-TEST(Overlay, SkeletonBecomesANodeWithLinesAndTriangles) {
-  const Mesh m = shapes::capsule(0.5f, 3.0f, 16, 6);
+SdfField constant_field(const Mesh& m) {
   SdfField f;
   f.values.assign(m.positions.size(), 1.0f);
   f.kept_rays.assign(m.positions.size(), 1u);
   f.filled.assign(m.positions.size(), 0);
+  return f;
+}
+}  // namespace
+
+TEST(Overlay, SkeletonBecomesANodeWithLinesAndTriangles) {
+  const Mesh m = shapes::capsule(0.5f, 3.0f, 16, 6);
+  const SdfField f = constant_field(m);
   io::WriteOptions o;
   io::Overlay skel;
   skel.name = "skeleton";
@@ -60,10 +65,7 @@ TEST(Overlay, SkeletonBecomesANodeWithLinesAndTriangles) {
 
 TEST(Overlay, ReadingTheFileBackTakesOnlyTheSurface) {
   const Mesh m = shapes::capsule(0.5f, 3.0f, 16, 6);
-  SdfField f;
-  f.values.assign(m.positions.size(), 1.0f);
-  f.kept_rays.assign(m.positions.size(), 1u);
-  f.filled.assign(m.positions.size(), 0);
+  const SdfField f = constant_field(m);
   io::WriteOptions o;
   io::Overlay skel;
   skel.name = "skeleton";
@@ -81,10 +83,7 @@ TEST(Overlay, ReadingTheFileBackTakesOnlyTheSurface) {
 
 TEST(Overlay, IndexOutOfRangeIsAnErrorAndWritesNothing) {
   const Mesh m = shapes::box(1, 1, 1, 1);
-  SdfField f;
-  f.values.assign(m.positions.size(), 1.0f);
-  f.kept_rays.assign(m.positions.size(), 1u);
-  f.filled.assign(m.positions.size(), 0);
+  const SdfField f = constant_field(m);
   io::WriteOptions o;
   io::Overlay bad;
   bad.name = "bad";

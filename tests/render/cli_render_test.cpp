@@ -6,6 +6,8 @@
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/io/field.hpp"
 
+#include "run.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -27,12 +29,7 @@ struct RunResult {
   std::string out, err;
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using sdfkit::test::slurp;
 
 // The number printed after `label` on its line of `text`.
 double number_after(const std::string& text, const std::string& label) {
@@ -51,10 +48,8 @@ protected:
   }
   void TearDown() override { fs::remove_all(dir_); }
   RunResult run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(SDFKIT_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    const auto r = sdfkit::test::run_command(std::string(SDFKIT_CLI) + " " + args, dir_);
+    return {r.exit_code, r.out, r.err};
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 

@@ -1,5 +1,7 @@
 // The procedural skeleton models: closed, manifold, outward, with the volume they should have.
 
+#include "analytic.hpp"
+
 #include "sdfkit/core/topology.hpp"
 #include "sdfkit/skeleton/models.hpp"
 
@@ -13,13 +15,6 @@ namespace models = sdfkit::skeleton::models;
 
 namespace {
 
-double signed_volume(const Mesh& m) {
-  double v = 0;
-  for (const Triangle& t : m.triangles)
-    v += glm::dot(glm::dvec3(m.positions[t[0]]),
-                  glm::cross(glm::dvec3(m.positions[t[1]]), glm::dvec3(m.positions[t[2]]))) / 6.0;
-  return v;
-}
 
 void expect_closed_manifold(const Mesh& m, std::size_t components = 1) {
   const MeshReport r = analyze(m);
@@ -45,7 +40,7 @@ TEST(SkeletonModels, CShapeIsAClosedBarWithTheBandArea) {
   EXPECT_EQ(euler(c.mesh), 2);
   // Cross-section: an annular sector of mean radius 0.6, thickness 0.2, 270 degrees.
   const double expected = 0.2 * 0.6 * 1.5 * M_PI * 3.0;
-  EXPECT_NEAR(signed_volume(c.mesh), expected, 0.01 * expected);
+  EXPECT_NEAR(test::signed_volume(c.mesh), expected, 0.01 * expected);
 }
 
 TEST(SkeletonModels, SShapeIsAClosedBarWithTheBandArea) {
@@ -53,14 +48,14 @@ TEST(SkeletonModels, SShapeIsAClosedBarWithTheBandArea) {
   expect_closed_manifold(s.mesh);
   EXPECT_EQ(euler(s.mesh), 2);
   const double expected = 0.2 * 2.0 * 0.5 * (225.0 * M_PI / 180.0) * 3.0;
-  EXPECT_NEAR(signed_volume(s.mesh), expected, 0.01 * expected);
+  EXPECT_NEAR(test::signed_volume(s.mesh), expected, 0.01 * expected);
 }
 
 TEST(SkeletonModels, StarIsASphereTopologyOnItsImplicitSurface) {
   const auto star = models::five_armed_star();
   expect_closed_manifold(star.mesh);
   EXPECT_EQ(euler(star.mesh), 2);
-  EXPECT_GT(signed_volume(star.mesh), 0.0);
+  EXPECT_GT(test::signed_volume(star.mesh), 0.0);
   for (const auto& p : star.mesh.positions) EXPECT_NEAR(star.fn(p), 0.0f, 2e-3f);
 }
 
@@ -68,6 +63,6 @@ TEST(SkeletonModels, Genus2HasEulerCharacteristicMinusTwo) {
   const auto g = models::genus2();
   expect_closed_manifold(g.mesh);
   EXPECT_EQ(euler(g.mesh), -2);
-  EXPECT_GT(signed_volume(g.mesh), 0.0);
+  EXPECT_GT(test::signed_volume(g.mesh), 0.0);
   for (const auto& p : g.mesh.positions) EXPECT_NEAR(g.fn(p), 0.0f, 2e-3f);
 }

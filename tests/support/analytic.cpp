@@ -74,6 +74,14 @@ float sphere_closed_form(float radius, const SdfOptions& o) {
   return gather(d, w).value;
 }
 
+double signed_volume(const Mesh& m) {
+  double v = 0;
+  for (const Triangle& t : m.triangles)
+    v += glm::dot(glm::dvec3(m.positions[t[0]]),
+                  glm::cross(glm::dvec3(m.positions[t[1]]), glm::dvec3(m.positions[t[2]]))) / 6.0;
+  return v;
+}
+
 std::string data_mesh(const std::string& name) { return std::string(SDFKIT_TEST_DATA_DIR) + "/" + name; }
 
 }  // namespace sdfkit::test

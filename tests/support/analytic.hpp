@@ -24,6 +24,9 @@ RawSdf analytic_sdf(const SdfQuery& query, const SdfOptions& options, const Impl
 // CGAL's rule every ray leaves the solid and passes.
 float sphere_closed_form(float radius, const SdfOptions& options);
 
+// Signed volume enclosed by a triangle mesh (positive when outward-oriented and closed).
+double signed_volume(const Mesh& mesh);
+
 // Path of a mesh from CGAL's data set extracted into the build tree ("cow.off").
 std::string data_mesh(const std::string& name);
 
