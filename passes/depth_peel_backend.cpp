@@ -607,6 +607,38 @@ void DepthPeelBackend::update_positions(std::span<const glm::vec3> positions) {
   impl_->timings = {{"upload_mesh", ms_since(t0)}};
 }
 
+RawSdf DepthPeelBackend::compute_in_chunks(const SdfQuery& query, const SdfOptions& options, std::size_t per_chunk) {
+  RawSdf out;
+  out.values.reserve(query.size());
+  out.kept_rays.reserve(query.size());
+  std::vector<StageTiming> total;
+  std::size_t chunks = 0;
+  for (std::size_t begin = 0; begin < query.size(); begin += per_chunk, ++chunks) {
+    const std::size_t end = std::min(query.size(), begin + per_chunk);
+    SdfQuery part;
+    part.domain = query.domain;
+    part.origin_offset = query.origin_offset;
+    part.origins.assign(query.origins.begin() + static_cast<std::ptrdiff_t>(begin), query.origins.begin() + static_cast<std::ptrdiff_t>(end));
+    part.normals.assign(query.normals.begin() + static_cast<std::ptrdiff_t>(begin), query.normals.begin() + static_cast<std::ptrdiff_t>(end));
+    if (!query.valid.empty())
+      part.valid.assign(query.valid.begin() + static_cast<std::ptrdiff_t>(begin), query.valid.begin() + static_cast<std::ptrdiff_t>(end));
+    RawSdf r = compute(part, options);
+    out.values.insert(out.values.end(), r.values.begin(), r.values.end());
+    out.kept_rays.insert(out.kept_rays.end(), r.kept_rays.begin(), r.kept_rays.end());
+    for (const StageTiming& t : impl_->timings) {
+      auto it = std::find_if(total.begin(), total.end(), [&](const StageTiming& x) { return x.stage == t.stage; });
+      if (it == total.end())
+        total.push_back(t);
+      else if (t.stage != "upload_mesh")
+        it->milliseconds += t.milliseconds;
+    }
+  }
+  log_info("depth peeling: " + std::to_string(query.size()) + " points in " + std::to_string(chunks) +
+           " chunks (the per-point sample storage exceeds one storage buffer)");
+  impl_->timings = std::move(total);
+  return out;
+}
+
 RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& options) {
   Impl& m = *impl_;
   validate_options(options);
@@ -621,6 +653,18 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   const std::uint32_t max_samples = m.cfg.max_samples_per_point > 0
                                         ? static_cast<std::uint32_t>(m.cfg.max_samples_per_point)
                                         : m.auto_max_samples(options.cone_degrees);
+  // The per-point sample storage must fit one storage buffer: larger queries run in chunks of
+  // points, each chunk rasterizing every camera again (a huge mesh costs more passes, not more
+  // memory than the device can address).
+  const std::size_t per_chunk = static_cast<std::size_t>(
+      m.ctx->capabilities().max_storage_buffer_range / (static_cast<VkDeviceSize>(max_samples) * sizeof(glm::vec2)));
+  const std::size_t limit = m.cfg.max_points_per_chunk > 0
+                                ? std::min(per_chunk, static_cast<std::size_t>(m.cfg.max_points_per_chunk))
+                                : per_chunk;
+  if (limit == 0)
+    throw DeviceError("one point's sample storage exceeds the device's storage buffer range; use fewer views or a "
+                      "smaller max_samples_per_point");
+  if (n > limit) return compute_in_chunks(query, options, limit);
   m.ensure_query_buffers(n, max_samples);
   {
     auto* p = static_cast<glm::vec4*>(m.points.mapped());

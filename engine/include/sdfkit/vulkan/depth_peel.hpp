@@ -81,6 +81,9 @@ struct DepthPeelConfig {
   bool validation = false;
   bool profile = false;         // per-pass GPU timestamps in last_timings()
   int max_samples_per_point = 0;  // 0 = automatic bound (see above)
+  // Points per compute chunk: queries whose sample storage exceeds the device's storage-buffer
+  // range run in chunks of points, each rasterizing every camera again. 0 = as many as fit.
+  int max_points_per_chunk = 0;
   int cameras_per_batch = 0;      // 0 = automatic (Layers: 1, measured fastest on lavapipe; lists: 8)
   int layers_per_submit = 0;      // 0 = adaptive (from the previous camera's layer count)
   FrontLayers front_layers = FrontLayers::Auto;
@@ -128,6 +131,10 @@ public:
   bool peels_front_layers() const;
 
 private:
+  // Splits a query whose per-point sample storage exceeds one storage buffer into chunks of
+  // `per_chunk` points (each chunk rasterizes every camera again); timings add up.
+  RawSdf compute_in_chunks(const SdfQuery& query, const SdfOptions& options, std::size_t per_chunk);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
