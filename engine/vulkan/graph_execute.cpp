@@ -243,6 +243,17 @@ std::vector<PassTiming> GraphExecutor::run(Context& ctx, const CompiledGraph& g,
                                              static_cast<std::uint32_t>(2 * i + 1));
     }
     record_barriers(ctx, cmd, g.final_barriers, p_images, p_buffers, p_infos);
+    // The host reads mapped buffers after the fence (read-backs, counters): make every device
+    // write of the graph available and visible to host reads.
+    VkMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    to_host.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    to_host.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
+    to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+    to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+    VkDependencyInfo host_dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    host_dep.memoryBarrierCount = 1;
+    host_dep.pMemoryBarriers = &to_host;
+    ctx.functions().cmd_pipeline_barrier2(cmd, &host_dep);
   });
 
   std::vector<PassTiming> timings;

@@ -18,6 +18,9 @@
 //
 // Simplifications (documented): an image is tracked as a whole (all layers, one mip level);
 // passes run on one queue in one command buffer.
+//
+// Every execution ends with a memory barrier from all device writes to host reads, so buffers
+// in host-visible memory (read-backs, counters) can be read once execute() has returned.
 
 #include <vulkan/vulkan.h>
 
