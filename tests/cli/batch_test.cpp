@@ -1,4 +1,6 @@
 // Batch planning without a device: input expansion, shards, output names.
+#include "scratch.hpp"
+
 #include "sdfkit/batch.hpp"
 #include "sdfkit/core/error.hpp"
 
@@ -15,14 +17,13 @@ namespace {
 class BatchPlan : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / "sdfkit_batch_plan";
-    fs::remove_all(dir_);
+    dir_ = scratch_.dir();
     fs::create_directories(dir_ / "a" / "deep");
     fs::create_directories(dir_ / "b");
     for (const char* f : {"a/x.off", "a/deep/y.glb", "a/notes.txt", "b/x.off", "b/z.PLY"})
       std::ofstream(dir_ / f) << "x";
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  sdfkit::test::ScratchDir scratch_;
   fs::path dir_;
 };
 }  // namespace

@@ -1,11 +1,13 @@
 // The glTF that sdfkit writes passes the Khronos glTF validator with zero errors: a fresh asset
 // from an OFF mesh, the write-back of a glTF asset, and a .gltf with its buffer beside it.
 #include "analytic.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -20,11 +22,9 @@ protected:
   void SetUp() override {
     ASSERT_TRUE(fs::exists(fs::path(SDFKIT_SOURCE_DIR) / "tools/gltf-validator/node_modules/gltf-validator"))
         << "run scripts/install-deps.sh (installs the Khronos glTF validator from npm)";
-    dir_ = fs::temp_directory_path() / "sdfkit_gltf_validator";
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    scratch_ = std::make_unique<sdfkit::test::ScratchDir>();
+    dir_ = scratch_->dir();
   }
-  void TearDown() override { fs::remove_all(dir_); }
   int compute(const std::string& in, const std::string& out) {
     return sh(std::string(SDFKIT_CLI) + " compute " + in + " -o " + (dir_ / out).string() +
               " --backend opencl --rays 8 --quiet");
@@ -32,6 +32,7 @@ protected:
   int validate(const std::string& files) {
     return std::system(("node " + validator() + " " + files).c_str());
   }
+  std::unique_ptr<sdfkit::test::ScratchDir> scratch_;
   fs::path dir_;
 };
 
