@@ -21,7 +21,7 @@ void add_batch_command(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("INPUT", a->inputs,
-                  "Mesh files, directories (searched recursively), manifests (*.list, *.manifest or @FILE: one path per line)")
+                  "Mesh files, directories (searched recursively), manifests (*.list, *.manifest, *.txt or @FILE: one path per line)")
       ->required();
   cmd->add_option("--out", a->out_dir, "Output directory (results and per-asset JSON records)")->required();
   cmd->add_option("--format", a->format, "Output format: glb gltf ply txt")->check(CLI::IsMember({"glb", "gltf", "ply", "txt"}));

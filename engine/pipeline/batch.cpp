@@ -27,7 +27,7 @@ bool is_mesh_file(const fs::path& p) {
 
 bool is_manifest(const std::string& s) {
   const std::string ext = fs::path(s).extension().string();
-  return ext == ".list" || ext == ".manifest";
+  return ext == ".list" || ext == ".manifest" || ext == ".txt";  // .txt is no mesh input format
 }
 
 void expand_one(const std::string& input, std::set<std::string>& out, int depth) {

@@ -42,6 +42,13 @@ TEST_F(BatchPlan, ManifestsResolveRelativePathsAndDeduplicate) {
   EXPECT_EQ(fs::path(files[1]).filename(), "z.PLY");
 }
 
+TEST_F(BatchPlan, TxtFilesAreManifests) {
+  std::ofstream(dir_ / "assets.txt") << "b/x.off\n";
+  const auto files = expand_inputs({(dir_ / "assets.txt").string()});
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_EQ(fs::path(files[0]).parent_path().filename(), "b");
+}
+
 TEST_F(BatchPlan, MissingInputIsAnError) {
   EXPECT_THROW(expand_inputs({(dir_ / "nope").string()}), InputError);
   std::ofstream(dir_ / "bad.list") << "missing.off\n";

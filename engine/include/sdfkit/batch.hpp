@@ -12,8 +12,8 @@
 namespace sdfkit {
 
 // Expands inputs into a sorted, de-duplicated list of mesh files: a file is taken as is; a
-// directory is searched recursively for .gltf .glb .obj .off .ply; a file ending in .list or
-// .manifest, or any "@FILE", is a manifest: one path per line ('#' comments, blank lines
+// directory is searched recursively for .gltf .glb .obj .off .ply; a file ending in .list,
+// .manifest or .txt, or any "@FILE", is a manifest: one path per line ('#' comments, blank lines
 // ignored, relative paths relative to the manifest). Throws InputError for a missing input.
 std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs);
 
