@@ -1,4 +1,5 @@
 #include "sdfkit/core/topology.hpp"
+#include "sdfkit/core/union_find.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -44,15 +45,6 @@ Adjacency from_pairs(std::size_t n, std::vector<std::pair<std::uint32_t, std::ui
   return adj;
 }
 
-struct UnionFind {
-  std::vector<std::uint32_t> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  std::uint32_t find(std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
-};
 
 }  // namespace
 

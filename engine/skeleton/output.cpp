@@ -1,8 +1,9 @@
 #include "sdfkit/skeleton/skeleton.hpp"
 
+#include "sdfkit/core/union_find.hpp"
+
 #include <nlohmann/json.hpp>
 
-#include <numeric>
 #include <ostream>
 #include <set>
 
@@ -38,19 +39,13 @@ void write_obj(std::ostream& out, const Skeleton& s) {
 int cycle_count(const Skeleton& s) {
   // First Betti number of the 1- and 2-cells: E - V + components - F (sheets enclose no volume).
   const std::size_t v = s.nodes.size();
-  std::vector<std::uint32_t> parent(v);
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
   std::set<std::array<std::uint32_t, 2>> edges(s.edges.begin(), s.edges.end());
   for (const Triangle& t : s.sheet_triangles)
     for (int i = 0; i < 3; ++i)
       edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
-  for (const auto& e : edges) parent[find(e[0])] = find(e[1]);
-  std::size_t components = 0;
-  for (std::uint32_t i = 0; i < v; ++i) components += find(i) == i;
+  UnionFind uf(v);
+  std::size_t components = v;
+  for (const auto& e : edges) components -= uf.unite(e[0], e[1]);
   return static_cast<int>(edges.size()) - static_cast<int>(v) + static_cast<int>(components) -
          static_cast<int>(s.sheet_triangles.size());
 }

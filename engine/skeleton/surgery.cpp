@@ -1,4 +1,5 @@
 #include "surgery.hpp"
+#include "sdfkit/core/union_find.hpp"
 
 #include <Eigen/Core>
 #include <glm/geometric.hpp>
@@ -8,7 +9,6 @@
 #include <algorithm>
 #include <chrono>
 #include <string>
-#include <numeric>
 #include <map>
 #include <queue>
 
@@ -262,20 +262,6 @@ void group_nodes(Complex& c, const SurgeryOptions& o, std::size_t& groupings) {
   }
 }
 
-struct UnionFind {
-  std::vector<std::uint32_t> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  std::uint32_t find(std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  bool unite(std::uint32_t a, std::uint32_t b) {
-    a = find(a), b = find(b);
-    if (a == b) return false;
-    parent[a] = b;
-    return true;
-  }
-};
 
 // Genus of each connected component of a closed mesh, indexed by the component's root in the
 // returned union-find over vertices: g = (2 - (V - E + F)) / 2.

@@ -74,6 +74,15 @@ float sphere_closed_form(float radius, const SdfOptions& o) {
   return gather(d, w).value;
 }
 
+float slab_closed_form(float thickness, const SdfOptions& o) {
+  std::vector<float> d, w;
+  for (const ConeRay& r : cone_rays(o.rays, o.cone_degrees)) {
+    d.push_back(thickness / std::cos(r.theta));
+    w.push_back(r.weight);
+  }
+  return gather(d, w).value;
+}
+
 double signed_volume(const Mesh& m) {
   double v = 0;
   for (const Triangle& t : m.triangles)

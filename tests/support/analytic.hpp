@@ -24,6 +24,10 @@ RawSdf analytic_sdf(const SdfQuery& query, const SdfOptions& options, const Impl
 // CGAL's rule every ray leaves the solid and passes.
 float sphere_closed_form(float radius, const SdfOptions& options);
 
+// The estimator's exact value in the middle of a slab of thickness h (far from its rims): every
+// ray crosses the thickness at length h / cos(theta) and both false-hit rules accept it.
+float slab_closed_form(float thickness, const SdfOptions& options);
+
 // Signed volume enclosed by a triangle mesh (positive when outward-oriented and closed).
 double signed_volume(const Mesh& mesh);
 
