@@ -6,6 +6,7 @@
 
 #include "gltf_builder.hpp"
 #include "io_test_util.hpp"
+#include "log_capture.hpp"
 
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
@@ -13,7 +14,6 @@
 
 #include <algorithm>
 #include <charconv>
-#include <mutex>
 #include <sstream>
 
 namespace sdfkit {
@@ -28,50 +28,14 @@ io::WriteOptions write_options(bool color, bool normalized) {
 
 using test::GltfBuilder;
 using test::ScratchDir;
-
-const std::string kCubeOff =
-    "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
-    "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n";
-
-// A field with distinct values per welded vertex (or face): value i = 0.5 + i * 0.25.
-SdfField ramp_field(const io::Asset& a, SdfDomain domain) {
-  SdfField f;
-  f.domain = domain;
-  const std::size_t n = domain == SdfDomain::Vertex ? a.mesh.vertex_count() : a.mesh.face_count();
-  for (std::size_t i = 0; i < n; ++i) f.values.push_back(0.5f + 0.25f * static_cast<float>(i));
-  f.kept_rays.assign(n, 30);
-  f.filled.assign(n, 0);
-  return f;
-}
+using test::WarningCapture;
+using test::kCubeOff;
+using test::ramp_field;
 
 // The value the writers must put on input vertex `v`.
 float vertex_value(const io::Asset& a, const SdfField& f, std::size_t v) {
   return f.values[a.input_to_welded[v]];
 }
-
-// Captures log warnings while alive.
-class WarningCapture {
-public:
-  WarningCapture() {
-    set_log_sink([this](LogLevel level, std::string_view m) {
-      if (level == LogLevel::Warning) {
-        std::lock_guard lock(mutex_);
-        messages_.emplace_back(m);
-      }
-    });
-  }
-  ~WarningCapture() { set_log_sink(nullptr); }
-  WarningCapture(const WarningCapture&) = delete;
-  WarningCapture& operator=(const WarningCapture&) = delete;
-  std::vector<std::string> messages() {
-    std::lock_guard lock(mutex_);
-    return messages_;
-  }
-
-private:
-  std::mutex mutex_;
-  std::vector<std::string> messages_;
-};
 
 // --- glTF inspection with tinygltf -------------------------------------------------------
 

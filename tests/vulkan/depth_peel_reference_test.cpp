@@ -1,7 +1,7 @@
 // The depth-peeling backend against the Embree reference on CGAL meshes, rotation invariance,
 // and the open and degenerate meshes of the set. Validation on throughout.
 
-#include "vk_test_util.hpp"
+#include "depth_peel_test_util.hpp"
 
 #include "analytic.hpp"
 #include "compare.hpp"
@@ -27,13 +27,7 @@ std::unique_ptr<DepthPeelBackend> make_backend(int views, int resolution, PeelMo
   cfg.mode = mode;
   cfg.views = views;
   cfg.resolution = resolution;
-  cfg.validation = true;
-  try {
-    return std::make_unique<DepthPeelBackend>(cfg);
-  } catch (const DeviceError&) {
-    if (test::allow_no_device()) return nullptr;
-    throw;
-  }
+  return test::make_test_backend(cfg);
 }
 
 // Values at points where both fields have a value of their own (not filled).

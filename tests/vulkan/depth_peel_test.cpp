@@ -1,10 +1,11 @@
 // The depth-peeling backend on lavapipe with validation on: the device gather against the shared
 // definition, analytic shapes against the ideal estimator, invariances, awkward meshes.
 
-#include "vk_test_util.hpp"
+#include "depth_peel_test_util.hpp"
 
 #include "analytic.hpp"
 #include "compare.hpp"
+#include "log_capture.hpp"
 
 #include "sdfkit/core/log.hpp"
 #include "sdfkit/core/shapes.hpp"
@@ -17,16 +18,7 @@
 namespace sdfkit::vk {
 namespace {
 
-// A backend with validation on, or nullptr when no device and SDFKIT_ALLOW_NO_DEVICE=1.
-std::unique_ptr<DepthPeelBackend> make_backend(DepthPeelConfig cfg) {
-  cfg.validation = true;
-  try {
-    return std::make_unique<DepthPeelBackend>(cfg);
-  } catch (const DeviceError&) {
-    if (test::allow_no_device()) return nullptr;
-    throw;
-  }
-}
+std::unique_ptr<DepthPeelBackend> make_backend(const DepthPeelConfig& cfg) { return test::make_test_backend(cfg); }
 
 DepthPeelConfig small_config(int views = 64, int resolution = 256) {
   DepthPeelConfig c;
@@ -168,12 +160,9 @@ TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
   // A torus has up to 4 layers along most views; with the cap at 1 only the outermost count.
   const Mesh m = shapes::torus(3.0f, 1.0f, 48, 24);
   be->set_mesh(m);
-  std::vector<std::string> warnings;
-  set_log_sink([&](LogLevel level, std::string_view msg) {
-    if (level == LogLevel::Warning) warnings.emplace_back(msg);
-  });
+  test::WarningCapture capture;
   const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
-  set_log_sink(nullptr);
+  const std::vector<std::string> warnings = capture.messages();
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("max_layers = 1"), std::string::npos) << warnings[0];
   EXPECT_EQ(be->last_layer_count(), 1);
@@ -219,12 +208,9 @@ TEST(DepthPeel, SamplesPastTheBoundAreDroppedWithAWarning) {
   if (!be) GTEST_SKIP() << "no Vulkan device";
   const Mesh m = shapes::capsule(1.0f, 4.0f, 24, 12);
   be->set_mesh(m);
-  std::vector<std::string> warnings;
-  set_log_sink([&](LogLevel level, std::string_view msg) {
-    if (level == LogLevel::Warning) warnings.emplace_back(msg);
-  });
+  test::WarningCapture capture;
   const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
-  set_log_sink(nullptr);
+  const std::vector<std::string> warnings = capture.messages();
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("more than 2 accepted views"), std::string::npos) << warnings[0];
   for (std::size_t i = 0; i < r.values.size(); ++i) {
@@ -337,12 +323,9 @@ TEST(DepthPeel, FragmentListOverflowGrowsTheNodesWithAWarning) {
   tiny->set_mesh(m);
   const SdfQuery q = make_query(m, SdfDomain::Vertex);
   const RawSdf want = roomy->compute(q, SdfOptions{});
-  std::vector<std::string> warnings;
-  set_log_sink([&](LogLevel level, std::string_view msg) {
-    if (level == LogLevel::Warning) warnings.emplace_back(msg);
-  });
+  test::WarningCapture capture;
   const RawSdf got = tiny->compute(q, SdfOptions{});
-  set_log_sink(nullptr);
+  const std::vector<std::string> warnings = capture.messages();
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("node buffer overflowed"), std::string::npos) << warnings[0];
   EXPECT_GT(tiny->last_dropped_fragments(), 0u);

@@ -1,0 +1,24 @@
+#pragma once
+// Shared by the depth-peeling tests: a backend with validation on.
+
+#include "vk_test_util.hpp"
+
+#include "sdfkit/vulkan/depth_peel.hpp"
+
+#include <memory>
+
+namespace sdfkit::test {
+
+// A validated depth-peeling backend, or nullptr when no device exists and
+// SDFKIT_ALLOW_NO_DEVICE=1 (a missing device fails otherwise).
+inline std::unique_ptr<vk::DepthPeelBackend> make_test_backend(vk::DepthPeelConfig config) {
+  config.validation = true;
+  try {
+    return std::make_unique<vk::DepthPeelBackend>(config);
+  } catch (const DeviceError&) {
+    if (allow_no_device()) return nullptr;
+    throw;
+  }
+}
+
+}  // namespace sdfkit::test
