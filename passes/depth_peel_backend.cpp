@@ -19,6 +19,8 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <span>
+#include <string_view>
 
 namespace sdfkit::vk {
 
@@ -118,6 +120,19 @@ const VkDescriptorType kResolveBindings[] = {
     VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
 const VkDescriptorType kGatherBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+
+// A pipeline that rasterizes the uploaded mesh: its positions (vec3) are vertex binding 0.
+GraphicsPipelineDescription mesh_raster_pipeline(std::string_view vertex_shader, std::string_view fragment_shader,
+                                                 std::span<const VkDescriptorType> bindings, std::uint32_t push_bytes) {
+  GraphicsPipelineDescription gd;
+  gd.vertex_shader = vertex_shader;
+  gd.fragment_shader = fragment_shader;
+  gd.bindings.assign(bindings.begin(), bindings.end());
+  gd.push_bytes = push_bytes;
+  gd.vertex_stride = sizeof(glm::vec3);
+  gd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+  return gd;
+}
 
 }  // namespace
 
@@ -224,13 +239,7 @@ DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
   cameras = make_cameras(cfg.views);
 
   VkDevice dev = ctx->device();
-  GraphicsPipelineDescription gd;
-  gd.vertex_shader = "depth_peel.vert";
-  gd.fragment_shader = "depth_peel.frag";
-  gd.bindings.assign(std::begin(kPeelBindings), std::end(kPeelBindings));
-  gd.push_bytes = sizeof(PeelPush);
-  gd.vertex_stride = sizeof(glm::vec3);
-  gd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+  GraphicsPipelineDescription gd = mesh_raster_pipeline("depth_peel.vert", "depth_peel.frag", kPeelBindings, sizeof(PeelPush));
   gd.color_formats = {kLayerFormat};
   gd.depth_format = kDepthFormat;
   gd.depth_compare = VK_COMPARE_OP_LESS;
@@ -278,13 +287,8 @@ void DepthPeelBackend::Impl::create_list_resources() {
   // Cameras per batch: one raster pass (instanced) and one resolve pass per batch.
   batch = cfg.cameras_per_batch > 0 ? std::min(cfg.cameras_per_batch, cfg.views) : std::min(8, cfg.views);
   VkDevice dev = ctx->device();
-  GraphicsPipelineDescription gd;
-  gd.vertex_shader = "fragment_list.vert";
-  gd.fragment_shader = "fragment_list.frag";
-  gd.bindings.assign(std::begin(kListBindings), std::end(kListBindings));
-  gd.push_bytes = sizeof(ListPush);
-  gd.vertex_stride = sizeof(glm::vec3);
-  gd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+  GraphicsPipelineDescription gd =
+      mesh_raster_pipeline("fragment_list.vert", "fragment_list.frag", kListBindings, sizeof(ListPush));
   gd.color_formats = {kListTargetFormat};
   gd.cull = VK_CULL_MODE_NONE;
   list_all = create_graphics_pipeline(*ctx, gd);
