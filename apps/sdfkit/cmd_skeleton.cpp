@@ -76,8 +76,9 @@ void add_skeleton_command(CLI::App& app) {
     } else if (ext == ".obj") {
       io::write_file_atomically(a->output, [&](std::ostream& os) { skeleton::write_obj(os, skel); });
     } else {
-      backend->set_mesh(asset.mesh);
-      const SdfField field = compute_sdf(*backend, asset.mesh, a->sdf.sdf);
+      SdfField field;  // the input's SDF, computed by extract() on its first iteration
+      field.domain = SdfDomain::Vertex;
+      field.values = skel.sdf;
       io::WriteOptions write = a->sdf.write;
       io::Overlay overlay;
       overlay.name = "skeleton";

@@ -439,6 +439,7 @@ Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions
   }
   Skeleton sk = build_skeleton(mesh, c.contracted, sdf, options);
   sk.iterations = c.iterations;
+  sk.sdf = std::move(sdf);
   sk.warnings.insert(sk.warnings.begin(), c.warnings.begin(), c.warnings.end());
   return sk;
 }

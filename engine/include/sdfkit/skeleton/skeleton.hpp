@@ -122,6 +122,9 @@ struct Skeleton {
   double reliability = 0.0;
   double curve_reliability = 0.0;  // the same for the curve skeleton before sheets were added
   int iterations = 0;              // contraction iterations
+  // Per-vertex SDF of the input mesh (model units, gaps filled) with the contraction's SDF
+  // options; empty when extract() ran without a backend.
+  std::vector<float> sdf;
   std::vector<std::string> warnings;
 };
 
