@@ -185,8 +185,18 @@ void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values
 
 }  // namespace detail
 
+void check_output(const std::string& out_path, SdfDomain domain) {
+  const Format format = format_from_path(out_path);
+  if ((format == Format::Gltf || format == Format::Glb) && domain != SdfDomain::Vertex)
+    throw InputError(out_path + ": per-face values cannot be stored in glTF; write .ply or .txt");
+  if (format == Format::Obj || format == Format::Off)
+    throw InputError(out_path + ": cannot store values in ." + format_name(format) +
+                     " files; write .gltf, .glb, .ply or .txt");
+}
+
 void write_field(const std::string& out_path, const Asset& asset, const SdfField& field,
                  const WriteOptions& options) {
+  check_output(out_path, field.domain);
   const Format format = format_from_path(out_path);
   const bool per_vertex = field.domain == SdfDomain::Vertex;
   const std::size_t expected = per_vertex ? asset.mesh.vertex_count() : asset.mesh.face_count();
@@ -198,11 +208,6 @@ void write_field(const std::string& out_path, const Asset& asset, const SdfField
     throw InputError(out_path + ": the asset's input-to-welded map does not match its vertices");
   if (!per_vertex && asset.input_triangles.size() != asset.mesh.face_count())
     throw InputError(out_path + ": the asset's input triangles do not match its mesh");
-  if ((format == Format::Gltf || format == Format::Glb) && !per_vertex)
-    throw InputError(out_path + ": per-face values cannot be stored in glTF; write .ply or .txt");
-  if (format == Format::Obj || format == Format::Off)
-    throw InputError(out_path + ": cannot store values in ." + format_name(format) +
-                     " files; write .gltf, .glb, .ply or .txt");
 
   // Values in input order: per input vertex through the weld map; faces keep their order.
   detail::OutputValues values;

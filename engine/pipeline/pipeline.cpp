@@ -76,11 +76,7 @@ ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& 
   Stopwatch clock;
 
   // Fail on an unwritable output before spending the compute time.
-  if (!request.output.empty()) {
-    const io::Format out = io::format_from_path(request.output);
-    if (request.sdf.domain == SdfDomain::Face && (out == io::Format::Gltf || out == io::Format::Glb))
-      throw InputError(request.output + ": per-face values cannot be stored in glTF; write .ply or .txt");
-  }
+  if (!request.output.empty()) io::check_output(request.output, request.sdf.domain);
 
   io::Asset asset = load_input(request.input, request.load);
   report.stages.push_back({"load", clock.lap_ms()});

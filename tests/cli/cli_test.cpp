@@ -131,4 +131,14 @@ TEST_F(Cli, BadOptionValuesAreUsageErrors) {
   EXPECT_NE(r.exit_code, 0);
 }
 
+TEST_F(Cli, AnUnwritableOutputIsReportedBeforeAnyDeviceIsOpened) {
+  // No device matches "no-such-device": had the device been opened first, that would be the error.
+  for (const char* out : {"x.off", "x.obj"})
+    expect_clean_error(run("compute builtin:sphere -o " + (dir_ / out).string() + " --device no-such-device"), out);
+  expect_clean_error(run("compute builtin:sphere --per face -o " + (dir_ / "x.glb").string() +
+                         " --device no-such-device"),
+                     "per-face values cannot be stored in glTF");
+  EXPECT_FALSE(fs::exists(dir_ / "x.off"));
+}
+
 TEST_F(Cli, UnknownBuiltin) { expect_clean_error(run("info builtin:teapot"), "builtin:teapot"); }

@@ -78,6 +78,11 @@ struct WriteOptions {
   std::vector<Overlay> overlays;  // glTF only
 };
 
+// Throws InputError when a `domain` field cannot be written to `out_path` at all: unknown
+// extension, OBJ/OFF (nowhere to put values), per-face values to glTF. Cheap: call it before
+// computing; write_field checks the same.
+void check_output(const std::string& out_path, SdfDomain domain);
+
 // Writes `field` (computed on asset.mesh) to out_path; the format follows the extension:
 //  - .gltf/.glb: per-vertex fields only. A glTF input is written back whole (materials,
 //    textures, other attributes, extensions, node hierarchy) with, on every triangle primitive,
