@@ -75,7 +75,7 @@ void add_compute_command(CLI::App& app) {
       return *backend;
     });
     if (!a->json.empty()) {
-      const std::string text = report_to_json(r);  // sdfkit::report_to_json
+      const std::string text = report_to_json(r);
       io::write_file_atomically(a->json, [&](std::ostream& os) { os << text << '\n'; });
     }
     if (a->quiet) return;

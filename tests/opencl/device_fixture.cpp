@@ -1,15 +1,9 @@
 #include "device_fixture.hpp"
 
-#include <cstdlib>
 #include <memory>
 #include <string>
 
 namespace sdfkit::test {
-
-bool no_device_allowed() {
-  const char* v = std::getenv("SDFKIT_ALLOW_NO_DEVICE");
-  return v != nullptr && std::string(v) == "1";
-}
 
 const char* tracer_name(Tracer t) {
   switch (t) {

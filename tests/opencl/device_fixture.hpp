@@ -2,6 +2,8 @@
 // One OpenCL backend shared by all tests of the binary (the program is compiled once).
 // Without an OpenCL device the tests fail, unless SDFKIT_ALLOW_NO_DEVICE=1 makes them skip.
 
+#include "device_policy.hpp"
+
 #include "sdfkit/opencl/opencl_backend.hpp"
 
 #include <gtest/gtest.h>
@@ -25,12 +27,11 @@ cl::OpenClBackend* opencl_backend(Tracer tracer = Tracer::BvhPackets);
 #define SDFKIT_REQUIRE_CL_ACCEL(var, tracer)                               \
   cl::OpenClBackend* var##_ptr = ::sdfkit::test::opencl_backend(tracer);   \
   if (var##_ptr == nullptr) {                                             \
-    if (::sdfkit::test::no_device_allowed())                              \
+    if (::sdfkit::test::allow_no_device())                              \
       GTEST_SKIP() << "no OpenCL device (SDFKIT_ALLOW_NO_DEVICE=1)";      \
     FAIL() << "no OpenCL device; install pocl-opencl-icd or set SDFKIT_ALLOW_NO_DEVICE=1"; \
   }                                                                       \
   cl::OpenClBackend& var = *var##_ptr
 
 namespace sdfkit::test {
-bool no_device_allowed();
 }

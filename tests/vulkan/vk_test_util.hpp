@@ -2,21 +2,17 @@
 // Shared by the Vulkan device tests: a context with validation on, the SDFKIT_ALLOW_NO_DEVICE
 // escape hatch (a missing device fails otherwise), and the zero-validation-message check.
 
+#include "device_policy.hpp"
+
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/vulkan/context.hpp"
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <memory>
 #include <string>
 
 namespace sdfkit::test {
-
-inline bool allow_no_device() {
-  const char* v = std::getenv("SDFKIT_ALLOW_NO_DEVICE");
-  return v && std::string(v) == "1";
-}
 
 // A validated context, or nullptr when no device exists and SDFKIT_ALLOW_NO_DEVICE=1.
 inline std::unique_ptr<vk::Context> make_test_context(vk::ContextConfig config = {}) {
