@@ -158,12 +158,14 @@ BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOption
   const auto outputs = plan_outputs(inputs, o.out_dir, o.format);
   summary.assets.resize(inputs.size());
   std::vector<std::size_t> todo;
+  std::vector<std::string> prints(inputs.size());  // input file and options, for the records
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     AssetOutcome& a = summary.assets[i];
     a.input = inputs[i];
     a.output = outputs[i];
     a.record = record_path(outputs[i]);
-    if (!o.force && complete(a.output, a.record, fingerprint(a.input, o))) {
+    prints[i] = fingerprint(a.input, o);
+    if (!o.force && complete(a.output, a.record, prints[i])) {
       a.status = AssetStatus::Skipped;
     } else {
       todo.push_back(i);
@@ -190,11 +192,11 @@ BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOption
     auto worker = [&](SdfBackend& backend) {
       for (std::size_t k; (k = next.fetch_add(1)) < todo.size();) {
         AssetOutcome& a = summary.assets[todo[k]];
+        const std::string& print = prints[todo[k]];
         const auto t0 = std::chrono::steady_clock::now();
         ComputeRequest req = o.base;
         req.input = a.input;
         req.output = a.output;
-        const std::string print = fingerprint(a.input, o);
         ComputeReport report;
         report.input = a.input;
         report.output = a.output;
