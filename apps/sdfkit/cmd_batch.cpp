@@ -29,6 +29,7 @@ void add_batch_command(CLI::App& app) {
   cmd->add_option("--shard", a->shard, "Process only shard I of N (I/N, 0-based), e.g. $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT");
   cmd->add_flag("--force", a->force, "Recompute assets whose result is already complete");
   add_sdf_options(*cmd, a->sdf);
+  add_output_options(*cmd, a->sdf, true);
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
     std::vector<std::string> inputs = expand_inputs(a->inputs);

@@ -8,7 +8,7 @@
 
 namespace sdfkit::cli {
 
-void add_sdf_options(CLI::App& cmd, SdfCliOptions& o) {
+void add_sdf_options(CLI::App& cmd, SdfCliOptions& o, const std::string& views_flag) {
   cmd.add_option("--backend", o.backend, "auto | vulkan | opencl (auto: Vulkan when a device exists)")
       ->check(CLI::IsMember({"auto", "vulkan", "opencl"}, CLI::ignore_case));
   cmd.add_option("--device", o.backend_config.device,
@@ -19,7 +19,7 @@ void add_sdf_options(CLI::App& cmd, SdfCliOptions& o) {
   cmd.add_option("--false-hits", o.false_hits,
                  "paper: drop hits facing the start normal | cgal: keep hits where the ray leaves the solid")
       ->check(CLI::IsMember({"paper", "cgal"}));
-  cmd.add_option("--views", o.backend_config.views, "Camera directions (Vulkan depth peeling)")
+  cmd.add_option(views_flag, o.backend_config.views, "Camera directions (Vulkan depth peeling)")
       ->check(CLI::Range(1, 4096));
   cmd.add_option("--resolution", o.backend_config.resolution, "Framebuffer size in pixels (Vulkan)")
       ->check(CLI::Range(16, 8192));
@@ -30,12 +30,16 @@ void add_sdf_options(CLI::App& cmd, SdfCliOptions& o) {
   cmd.add_option("--accel", o.backend_config.accel, "OpenCL acceleration structure: bvh (default) | octree")
       ->check(CLI::IsMember({"bvh", "octree"}));
   cmd.add_flag("--profile", o.backend_config.profile, "Time each pass on the device");
-  cmd.add_option("--smooth", o.smooth, "k-ring Gaussian smoothing of the result (rings, 0 = off)")
-      ->check(CLI::Range(0, 64));
-  cmd.add_flag("--normalize", o.write.normalized, "Write values normalised to [0, 1]");
-  cmd.add_flag("--no-color", o.no_color, "Do not write COLOR_0 / PLY colours");
   cmd.add_option("--weld-tolerance", o.load.weld_tolerance, "Weld positions closer than this (model units)")
       ->check(CLI::NonNegativeNumber);
+}
+
+void add_output_options(CLI::App& cmd, SdfCliOptions& o, bool smoothing) {
+  if (smoothing)
+    cmd.add_option("--smooth", o.smooth, "k-ring Gaussian smoothing of the result (rings, 0 = off)")
+        ->check(CLI::Range(0, 64));
+  cmd.add_flag("--normalize", o.write.normalized, "Write values normalised to [0, 1]");
+  cmd.add_flag("--no-color", o.no_color, "Do not write COLOR_0 / PLY colours");
 }
 
 void finish_sdf_options(SdfCliOptions& o) {
@@ -60,6 +64,7 @@ void add_compute_command(CLI::App& app) {
   cmd->add_option("--json", a->json, "Also write a JSON report of the run to this file");
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
   add_sdf_options(*cmd, a->sdf);
+  add_output_options(*cmd, a->sdf, true);
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
     ComputeRequest req;

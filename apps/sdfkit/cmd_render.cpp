@@ -98,9 +98,8 @@ void add_render_command(CLI::App& app) {
       ->expected(2);
   cmd->add_flag("--no-histogram", a->no_histogram, "Leave out the histogram");
   cmd->add_flag("--no-colorbar", a->no_colorbar, "Leave out the colour bar");
-  add_sdf_options(*cmd, a->sdf);
-  // --views names the figure's views here, not the depth-peeling directions; outputs are PNG.
-  for (const char* name : {"--views", "--normalize", "--no-color"}) cmd->remove_option(cmd->get_option(name));
+  // --views names the figure's views here; the depth peeling's camera count is --sdf-views.
+  add_sdf_options(*cmd, a->sdf, "--sdf-views");
   add_figure_options(*cmd, a->figure);
   cmd->callback([a] {
     finish_sdf_options(a->sdf);

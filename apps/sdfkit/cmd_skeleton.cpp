@@ -51,6 +51,7 @@ void add_skeleton_command(CLI::App& app) {
   cmd->add_option("--iterations", a->iterations, "Contraction iteration cap")->check(CLI::Range(1, 200));
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
   add_sdf_options(*cmd, a->sdf);
+  add_output_options(*cmd, a->sdf, false);
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
     const std::string ext = extension_of(a->output);

@@ -33,7 +33,11 @@ struct SdfCliOptions {
   bool no_color = false;
   int smooth = 0;
 };
-void add_sdf_options(CLI::App& cmd, SdfCliOptions& o);
+// How the SDF is computed: backend, device, sampling, Vulkan and OpenCL settings, welding.
+// `views_flag` names the Vulkan camera count (render uses --views for its figure).
+void add_sdf_options(CLI::App& cmd, SdfCliOptions& o, const std::string& views_flag = "--views");
+// How results are written: --normalize, --no-color, and with `smoothing` --smooth K.
+void add_output_options(CLI::App& cmd, SdfCliOptions& o, bool smoothing);
 // Resolves the parsed strings into o.sdf / o.backend_config / o.write (throws InputError).
 void finish_sdf_options(SdfCliOptions& o);
 

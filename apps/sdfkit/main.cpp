@@ -31,7 +31,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // CLI11 prints the message (or the help / version, which succeed); every usage error is 2.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const sdfkit::Error& e) {
     std::fprintf(stderr, "sdfkit: error: %s\n", e.what());
     return 1;

@@ -128,7 +128,8 @@ TEST_F(Cli, FailedComputeWritesNothingAndKeepsAnExistingFile) {
 TEST_F(Cli, BadOptionValuesAreUsageErrors) {
   const RunResult r = run("compute builtin:sphere -o x.txt --rays 0");
   EXPECT_FALSE(r.signaled);
-  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(run("--help").exit_code, 0);
 }
 
 TEST_F(Cli, AnUnwritableOutputIsReportedBeforeAnyDeviceIsOpened) {
@@ -139,6 +140,16 @@ TEST_F(Cli, AnUnwritableOutputIsReportedBeforeAnyDeviceIsOpened) {
                          " --device no-such-device"),
                      "per-face values cannot be stored in glTF");
   EXPECT_FALSE(fs::exists(dir_ / "x.off"));
+}
+
+TEST_F(Cli, CommandsRefuseOptionsTheyWouldIgnore) {
+  // Skeletons and renders do not smooth; render's own --views is its figure's.
+  for (const char* cmd : {"skeleton builtin:capsule -o s.json --smooth 2", "render builtin:capsule -o r.png --smooth 2",
+                          "render builtin:capsule -o r.png --normalize"}) {
+    const RunResult r = run(cmd);
+    EXPECT_FALSE(r.signaled) << cmd;
+    EXPECT_EQ(r.exit_code, 2) << cmd << ": " << r.err;  // a usage error
+  }
 }
 
 TEST_F(Cli, UnknownBuiltin) { expect_clean_error(run("info builtin:teapot"), "builtin:teapot"); }
