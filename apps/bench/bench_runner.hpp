@@ -38,6 +38,7 @@ struct BenchOptions {
 
 struct BackendRun {
   std::string backend, device, mode;  // mode: "vertex/30 rays", "face/25 rays", "vertex/128 views 512px"
+  double session_ms = 0;     // creating the backend session (device, programs, pipelines)
   double first_ms = 0;       // set_mesh + compute, cold
   double repeat_ms = 0;      // update_positions + compute, median of repeats
   double repeat_cpu_ms = 0;  // process CPU time (all threads) of the median warm call
