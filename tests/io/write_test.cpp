@@ -28,7 +28,7 @@ io::WriteOptions write_options(bool color, bool normalized) {
 
 using test::GltfBuilder;
 using test::ScratchDir;
-using test::WarningCapture;
+using test::LogCapture;
 using test::kCubeOff;
 using test::ramp_field;
 
@@ -121,7 +121,7 @@ TEST_P(WriteGltfBack, KeepsTheModelAndAddsSdfAttributes) {
   // Into another directory: the output must not depend on files next to the input.
   std::filesystem::create_directory(dir.path("out"));
   const std::string out = dir.path("out/result." + GetParam());
-  WarningCapture warnings;
+  LogCapture warnings;
   io::write_field(out, a, field);
   const std::vector<std::string> logged = warnings.messages();
   ASSERT_EQ(logged.size(), 1u);
@@ -189,7 +189,7 @@ TEST(WriteGltf, MissingImageFileIsAWarningAndKeepsItsUri) {
   ScratchDir dir;
   const std::string in =
       dir.write("tri.gltf", b.data_uri_gltf("\"scene\":0,\"scenes\":[{\"nodes\":[0]}]"));
-  WarningCapture warnings;
+  LogCapture warnings;
   const io::Asset a = io::load_asset(in);
   EXPECT_TRUE(std::any_of(a.warnings.begin(), a.warnings.end(), [](const std::string& w) {
     return w.find("missing.png") != std::string::npos;

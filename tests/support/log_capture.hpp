@@ -1,6 +1,6 @@
 #pragma once
-// Captures the engine's log warnings while alive (restores the default sink on scope exit, also
-// when an assertion fails in between).
+// Captures the engine's log messages of one level while alive, lowering the log level to it if
+// needed; restores the default sink and level on scope exit, also when an assertion fails.
 
 #include "sdfkit/core/log.hpp"
 
@@ -11,25 +11,30 @@
 
 namespace sdfkit::test {
 
-class WarningCapture {
+class LogCapture {
 public:
-  WarningCapture() {
-    set_log_sink([this](LogLevel level, std::string_view m) {
-      if (level == LogLevel::Warning) {
+  explicit LogCapture(LogLevel level = LogLevel::Warning) : previous_(log_level()) {
+    if (level < previous_) set_log_level(level);
+    set_log_sink([this, level](LogLevel l, std::string_view m) {
+      if (l == level) {
         std::lock_guard lock(mutex_);
         messages_.emplace_back(m);
       }
     });
   }
-  ~WarningCapture() { set_log_sink(nullptr); }
-  WarningCapture(const WarningCapture&) = delete;
-  WarningCapture& operator=(const WarningCapture&) = delete;
+  ~LogCapture() {
+    set_log_sink(nullptr);
+    set_log_level(previous_);
+  }
+  LogCapture(const LogCapture&) = delete;
+  LogCapture& operator=(const LogCapture&) = delete;
   std::vector<std::string> messages() {
     std::lock_guard lock(mutex_);
     return messages_;
   }
 
 private:
+  LogLevel previous_;
   std::mutex mutex_;
   std::vector<std::string> messages_;
 };

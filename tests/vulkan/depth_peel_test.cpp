@@ -144,8 +144,13 @@ TEST(DepthPeel, PointsInChunksGiveTheSameValues) {
   a->set_mesh(m);
   b->set_mesh(m);
   const SdfField fa = compute_sdf(*a, m, SdfOptions{});
+  test::LogCapture capture(LogLevel::Info);
   const SdfField fb = compute_sdf(*b, m, SdfOptions{});
+  const std::vector<std::string> infos = capture.messages();
   ASSERT_GT(m.positions.size(), 300u);
+  const std::string chunks = std::to_string((m.positions.size() + 99) / 100) + " chunks";
+  ASSERT_EQ(infos.size(), 1u);
+  EXPECT_NE(infos[0].find(chunks), std::string::npos) << infos[0];
   EXPECT_EQ(fa.values, fb.values);
   EXPECT_EQ(fa.kept_rays, fb.kept_rays);
   SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(b->context());
@@ -160,7 +165,7 @@ TEST(DepthPeel, MaxLayersCapStillGivesValuesForOuterLayers) {
   // A torus has up to 4 layers along most views; with the cap at 1 only the outermost count.
   const Mesh m = shapes::torus(3.0f, 1.0f, 48, 24);
   be->set_mesh(m);
-  test::WarningCapture capture;
+  test::LogCapture capture;
   const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
   const std::vector<std::string> warnings = capture.messages();
   ASSERT_EQ(warnings.size(), 1u);
@@ -208,7 +213,7 @@ TEST(DepthPeel, SamplesPastTheBoundAreDroppedWithAWarning) {
   if (!be) GTEST_SKIP() << "no Vulkan device";
   const Mesh m = shapes::capsule(1.0f, 4.0f, 24, 12);
   be->set_mesh(m);
-  test::WarningCapture capture;
+  test::LogCapture capture;
   const RawSdf r = be->compute(make_query(m, SdfDomain::Vertex), SdfOptions{});
   const std::vector<std::string> warnings = capture.messages();
   ASSERT_EQ(warnings.size(), 1u);
@@ -323,7 +328,7 @@ TEST(DepthPeel, FragmentListOverflowGrowsTheNodesWithAWarning) {
   tiny->set_mesh(m);
   const SdfQuery q = make_query(m, SdfDomain::Vertex);
   const RawSdf want = roomy->compute(q, SdfOptions{});
-  test::WarningCapture capture;
+  test::LogCapture capture;
   const RawSdf got = tiny->compute(q, SdfOptions{});
   const std::vector<std::string> warnings = capture.messages();
   ASSERT_EQ(warnings.size(), 1u);
