@@ -11,14 +11,8 @@ namespace sdfkit::test {
 
 // A validated depth-peeling backend, or nullptr when no device exists and
 // SDFKIT_ALLOW_NO_DEVICE=1 (a missing device fails otherwise).
-inline std::unique_ptr<vk::DepthPeelBackend> make_test_backend(vk::DepthPeelConfig config) {
-  config.validation = true;
-  try {
-    return std::make_unique<vk::DepthPeelBackend>(config);
-  } catch (const DeviceError&) {
-    if (allow_no_device()) return nullptr;
-    throw;
-  }
+inline std::unique_ptr<vk::DepthPeelBackend> make_test_backend(const vk::DepthPeelConfig& config) {
+  return make_validated<vk::DepthPeelBackend>(config);
 }
 
 }  // namespace sdfkit::test

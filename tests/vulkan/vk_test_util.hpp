@@ -14,15 +14,22 @@
 
 namespace sdfkit::test {
 
-// A validated context, or nullptr when no device exists and SDFKIT_ALLOW_NO_DEVICE=1.
-inline std::unique_ptr<vk::Context> make_test_context(vk::ContextConfig config = {}) {
+// A T made from `config` with validation on, or nullptr when no device exists and
+// SDFKIT_ALLOW_NO_DEVICE=1 (a missing device fails otherwise).
+template <typename T, typename Config>
+std::unique_ptr<T> make_validated(Config config) {
   config.validation = true;
   try {
-    return std::make_unique<vk::Context>(config);
+    return std::make_unique<T>(config);
   } catch (const DeviceError&) {
     if (allow_no_device()) return nullptr;
     throw;
   }
+}
+
+// A validated context, or nullptr when no device exists and SDFKIT_ALLOW_NO_DEVICE=1.
+inline std::unique_ptr<vk::Context> make_test_context(vk::ContextConfig config = {}) {
+  return make_validated<vk::Context>(config);
 }
 
 // Joins the validation messages for a failure message.
