@@ -4,6 +4,7 @@
 
 #include "sdfkit/core/error.hpp"
 
+#include <glm/common.hpp>
 #include <glm/vec4.hpp>
 
 #include <algorithm>
@@ -97,6 +98,38 @@ std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
+}
+
+// 30-bit Morton code of a point quantized to 1024 cells per axis of [lo, lo + extent].
+std::uint32_t morton3(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& inv_extent) {
+  const auto spread = [](std::uint32_t x) {  // bit i of x -> bit 3i
+    x &= 0x3ffu;
+    x = (x | (x << 16)) & 0x030000ffu;
+    x = (x | (x << 8)) & 0x0300f00fu;
+    x = (x | (x << 4)) & 0x030c30c3u;
+    return (x | (x << 2)) & 0x09249249u;
+  };
+  const glm::vec3 q = glm::clamp((p - lo) * inv_extent, 0.0f, 1.0f) * 1023.0f;
+  return spread(static_cast<std::uint32_t>(q.x)) | (spread(static_cast<std::uint32_t>(q.y)) << 1) |
+         (spread(static_cast<std::uint32_t>(q.z)) << 2);
+}
+
+// The query's point indices sorted along a Morton curve of their positions (ties by index).
+std::vector<std::uint32_t> spatial_order(std::span<const glm::vec3> points) {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const glm::vec3& p : points) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  const glm::vec3 extent = glm::max(hi - lo, glm::vec3(std::numeric_limits<float>::min()));
+  const glm::vec3 inv = 1.0f / extent;
+  std::vector<std::uint64_t> keyed(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    keyed[i] = (std::uint64_t{morton3(points[i], lo, inv)} << 32) | i;
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> order(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
+  return order;
 }
 
 }  // namespace
@@ -383,11 +416,17 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
   m.batch_bytes = m.points.size() + m.normals.size() + m.keys.size() + m.values.size() +
                   m.kept.size() + m.table.size();
 
+  // Points are traced in Morton order of their origins (neighbouring work items meet the same
+  // nodes and triangles, which keeps them in cache); the results go back to query order.
+  const std::vector<std::uint32_t> order = spatial_order(query.origins);
   std::vector<glm::vec4> pts(n), nrm(n);
   for (std::size_t i = 0; i < n; ++i) {
-    pts[i] = glm::vec4(query.origins[i], query.valid[i] ? 1.0f : 0.0f);
-    nrm[i] = glm::vec4(query.normals[i], 0.0f);
+    const std::uint32_t q = order[i];
+    pts[i] = glm::vec4(query.origins[q], query.valid[q] ? 1.0f : 0.0f);
+    nrm[i] = glm::vec4(query.normals[q], 0.0f);
   }
+  std::vector<float> values(n);
+  std::vector<std::uint32_t> kept(n);
   const cl_int rule = static_cast<cl_int>(options.false_hit);
   for (std::size_t first = 0; first < n; first += batch) {
     const std::size_t count = std::min(batch, n - first);
@@ -412,16 +451,20 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
              m.table.get(), m.values.get(), m.kept.get());
     m.run(m.k_gather.get(), count, 0, "gather_points");
     check(clEnqueueReadBuffer(m.queue.get(), m.values.get(), CL_FALSE, 0, count * sizeof(float),
-                              &raw.values[first], 0, nullptr, nullptr),
+                              &values[first], 0, nullptr, nullptr),
           "reading SDF values back");
     check(clEnqueueReadBuffer(m.queue.get(), m.kept.get(), CL_FALSE, 0,
-                              count * sizeof(std::uint32_t), &raw.kept_rays[first], 0, nullptr,
+                              count * sizeof(std::uint32_t), &kept[first], 0, nullptr,
                               nullptr),
           "reading kept-ray counts back");
     // The host arrays of this batch stay alive until the finish below; the in-order queue
     // makes the next batch's uploads wait for this batch's kernels.
   }
   m.finish("tracing rays");
+  for (std::size_t i = 0; i < n; ++i) {
+    raw.values[order[i]] = values[i];
+    raw.kept_rays[order[i]] = kept[i];
+  }
   m.trace_ms = ms_since(start);
   return raw;
 }
