@@ -12,6 +12,7 @@ layout(push_constant) uniform Push {
   uint camera_base;
   int resolution;
   uint capacity;
+  uint first_primitive;  // draw-order index of the draw's first triangle
 } pc;
 
 layout(location = 0) flat out uint out_camera;  // index within the batch

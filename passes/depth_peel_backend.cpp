@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <map>
 #include <span>
@@ -62,6 +63,7 @@ struct ListPush {
   std::uint32_t camera_base;
   std::int32_t resolution;
   std::uint32_t capacity;
+  std::uint32_t first_primitive;  // draw-order index of the draw's first triangle
 };
 struct ResolvePush {
   glm::vec4 center_scale;
@@ -103,6 +105,64 @@ std::vector<GpuCamera> make_cameras(int n) {
     cams[static_cast<std::size_t>(i)] = {glm::vec4(f.t, 0.0f), glm::vec4(f.b, 0.0f), glm::vec4(f.axis, 0.0f)};
   }
   return cams;
+}
+
+// A group of drawn triangles whose outward normals lie within a cone (FragmentLists, closed
+// meshes). A camera looking along `view` culls a triangle whose normal faces it (dot < 0); it
+// skips the whole group, before vertex processing, when every normal in the cone faces it by
+// more than kBinMarginDegrees, so the skipped triangles are exactly ones the pipeline would cull.
+struct NormalBin {
+  glm::vec3 dir{0.0f};       // unit axis of the cone
+  float skip_below = -2.0f;  // skip when dot(dir, view) < skip_below (-2: never)
+  std::uint32_t first = 0;   // first triangle of the group in draw order
+  std::uint32_t count = 0;
+};
+constexpr double kBinMarginDegrees = 2.0;
+
+// Groups unit normals into `bins` cones around spherical Fibonacci axes (nearest axis). Returns
+// the groups (empty ones dropped) and fills `order` with the triangles sorted by group.
+std::vector<NormalBin> bin_normals(std::span<const glm::vec4> normals, int bins, std::vector<std::uint32_t>& order) {
+  std::vector<glm::dvec3> axes(static_cast<std::size_t>(bins));
+  for (int i = 0; i < bins; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / bins;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = std::fmod(i * kGoldenAngle, 2.0 * M_PI);
+    axes[static_cast<std::size_t>(i)] = glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  std::vector<std::uint32_t> bin_of(normals.size());
+  std::vector<double> min_cos(axes.size(), 1.0);
+  std::vector<std::uint32_t> counts(axes.size() + 1, 0);
+  for (std::size_t t = 0; t < normals.size(); ++t) {
+    const glm::dvec3 n(normals[t]);
+    std::size_t best = 0;
+    double best_dot = -2.0;
+    for (std::size_t b = 0; b < axes.size(); ++b) {
+      const double d = glm::dot(axes[b], n);
+      if (d > best_dot) {
+        best_dot = d;
+        best = b;
+      }
+    }
+    bin_of[t] = static_cast<std::uint32_t>(best);
+    min_cos[best] = std::min(min_cos[best], best_dot);
+    ++counts[best + 1];
+  }
+  for (std::size_t b = 0; b < axes.size(); ++b) counts[b + 1] += counts[b];
+  order.resize(normals.size());
+  std::vector<std::uint32_t> next(counts.begin(), counts.end() - 1);
+  for (std::size_t t = 0; t < normals.size(); ++t) order[next[bin_of[t]]++] = static_cast<std::uint32_t>(t);
+  std::vector<NormalBin> out;
+  for (std::size_t b = 0; b < axes.size(); ++b) {
+    if (counts[b + 1] == counts[b]) continue;
+    NormalBin nb;
+    nb.dir = glm::vec3(axes[b]);
+    const double spread = std::acos(std::clamp(min_cos[b], -1.0, 1.0)) + kBinMarginDegrees * M_PI / 180.0;
+    if (spread < 0.5 * M_PI) nb.skip_below = static_cast<float>(-std::sin(spread));
+    nb.first = counts[b];
+    nb.count = counts[b + 1] - counts[b];
+    out.push_back(nb);
+  }
+  return out;
 }
 
 const VkDescriptorType kPeelBindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
@@ -169,6 +229,7 @@ struct DepthPeelBackend::Impl {
   std::size_t vertex_count = 0;
   bool front_layers = true;  // peel front layers for the current mesh
   std::vector<std::uint32_t> drawn;  // non-degenerate triangles, in index-buffer order
+  std::vector<NormalBin> bins;       // FragmentLists on closed meshes: drawn triangles by normal
   Buffer position_buffer;            // V x vec3
   Buffer index_buffer;               // drawn x 3
   Buffer normal_buffer;              // drawn x vec4 (outward unit normal)
@@ -189,6 +250,7 @@ struct DepthPeelBackend::Impl {
   Buffer counter;  // fragments appended by the last batch (host-read)
   std::size_t node_capacity = 0;
   std::size_t dropped = 0;
+  std::size_t submitted = 0;  // triangles drawn by the last run_lists, over all cameras
 
   std::vector<StageTiming> timings;
   int last_layers = 0;
@@ -330,9 +392,25 @@ void DepthPeelBackend::Impl::upload_geometry(std::span<const glm::vec3> position
     const glm::vec3 a = positions[t[0]], b = positions[t[1]], c = positions[t[2]];
     if (triangle_is_degenerate(a, b, c)) continue;
     drawn.push_back(static_cast<std::uint32_t>(f));
-    indices.insert(indices.end(), t.begin(), t.end());
     normals.emplace_back(glm::normalize(glm::cross(b - a, c - a)), 0.0f);
   }
+  // Closed meshes in FragmentLists mode draw back faces only: draw order by normal group, so a
+  // camera can skip the groups facing it. Otherwise the input order.
+  bins.clear();
+  if (lists && !front_layers && cfg.normal_bins > 1 && !drawn.empty()) {
+    std::vector<std::uint32_t> order;
+    bins = bin_normals(normals, cfg.normal_bins, order);
+    std::vector<std::uint32_t> sorted_drawn(drawn.size());
+    std::vector<glm::vec4> sorted_normals(normals.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      sorted_drawn[i] = drawn[order[i]];
+      sorted_normals[i] = normals[order[i]];
+    }
+    drawn = std::move(sorted_drawn);
+    normals = std::move(sorted_normals);
+  }
+  indices.reserve(3 * drawn.size());
+  for (std::uint32_t f : drawn) indices.insert(indices.end(), triangles[f].begin(), triangles[f].end());
   auto upload = [&](Buffer& buf, const void* data, std::size_t bytes, VkBufferUsageFlags usage) {
     const std::size_t alloc = std::max<std::size_t>(bytes, 16);
     if (!buf.buffer || buf.size < alloc) buf = create_buffer(*ctx, alloc, usage, MemoryUse::Upload);
@@ -446,6 +524,7 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
   const auto groups = static_cast<std::uint32_t>((n + 63) / 64);
   const Pipeline& raster = front_layers ? list_all : list_back;
   dropped = 0;
+  submitted = 0;
   for (int base = 0; base < cfg.views;) {
     const auto count = static_cast<std::uint32_t>(std::min(batch, cfg.views - base));
     RenderGraph g;
@@ -476,8 +555,8 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
     ctr = list.atomic(ctr);
     nd = list.storage_write(nd);
     const ListPush lp{center_scale, static_cast<std::uint32_t>(base), cfg.resolution,
-                      static_cast<std::uint32_t>(node_capacity)};
-    list.execute([&, lp, count](PassContext& pc) {
+                      static_cast<std::uint32_t>(node_capacity), 0};
+    list.execute([&, lp, count, base](PassContext& pc) {
       const VkDeviceSize zero = 0;
       const VkBuffer vb = pc.buffer(pos);
       vkCmdBindVertexBuffers(pc.cmd, 0, 1, &vb, &zero);
@@ -487,7 +566,31 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
                               nullptr);
       vkCmdPushConstants(pc.cmd, raster.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                          sizeof(lp), &lp);
-      vkCmdDrawIndexed(pc.cmd, index_count, count, 0, 0, 0);
+      if (bins.empty()) {
+        vkCmdDrawIndexed(pc.cmd, index_count, count, 0, 0, 0);
+        submitted += static_cast<std::size_t>(index_count / 3) * count;
+        return;
+      }
+      // One draw per run of consecutive groups that the camera does not skip; the instance
+      // index still names the camera within the batch.
+      constexpr auto kFirstOffset = static_cast<std::uint32_t>(offsetof(ListPush, first_primitive));
+      for (std::uint32_t c = 0; c < count; ++c) {
+        const glm::vec3 view(cameras[static_cast<std::size_t>(base) + c].dir);
+        for (std::size_t b = 0; b < bins.size();) {
+          if (glm::dot(bins[b].dir, view) < bins[b].skip_below) {
+            ++b;
+            continue;
+          }
+          const std::uint32_t first = bins[b].first;
+          std::uint32_t end = first + bins[b].count;
+          for (++b; b < bins.size() && !(glm::dot(bins[b].dir, view) < bins[b].skip_below); ++b)
+            end = bins[b].first + bins[b].count;
+          vkCmdPushConstants(pc.cmd, raster.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                             kFirstOffset, sizeof(first), &first);
+          vkCmdDrawIndexed(pc.cmd, 3 * (end - first), 1, 3 * first, 0, c);
+          submitted += end - first;
+        }
+      }
     });
     auto rs = g.add_pass("resolve_lists", PassKind::Compute);
     rs.storage_read(hd);
@@ -582,6 +685,7 @@ const DepthPeelConfig& DepthPeelBackend::config() const { return impl_->cfg; }
 int DepthPeelBackend::last_layer_count() const { return impl_->last_layers; }
 std::size_t DepthPeelBackend::fragment_capacity() const { return impl_->node_capacity; }
 std::size_t DepthPeelBackend::last_dropped_fragments() const { return impl_->dropped; }
+std::size_t DepthPeelBackend::last_submitted_triangles() const { return impl_->submitted; }
 bool DepthPeelBackend::peels_front_layers() const { return impl_->front_layers; }
 std::vector<StageTiming> DepthPeelBackend::last_timings() const { return impl_->timings; }
 std::size_t DepthPeelBackend::device_memory_bytes() const {

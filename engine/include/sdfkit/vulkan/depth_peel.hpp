@@ -97,6 +97,11 @@ struct DepthPeelConfig {
   PeelMode mode = PeelMode::FragmentLists;
   // FragmentLists only: initial nodes of the node buffer (0 = automatic, see PeelMode).
   std::size_t fragment_capacity = 0;
+  // FragmentLists on closed meshes (back faces only): the triangles are grouped into this many
+  // cones of normal directions and a camera does not draw the groups that face it, which the
+  // pipeline would cull triangle by triangle after vertex processing. 0 or 1 = one draw of all
+  // triangles per camera. Same values either way.
+  int normal_bins = 64;
 };
 
 // Devices as `sdfkit devices` shows them, with suitability for this backend.
@@ -127,6 +132,10 @@ public:
   // re-run after growing) in the last compute().
   std::size_t fragment_capacity() const;
   std::size_t last_dropped_fragments() const;
+  // FragmentLists: triangles sent to the pipeline, summed over the cameras, in the last
+  // compute() (its last chunk of points when it ran in chunks). Without normal groups (or on an
+  // open mesh) this is views x non-degenerate triangles.
+  std::size_t last_submitted_triangles() const;
   // Whether front layers are peeled for the current mesh (see FrontLayers).
   bool peels_front_layers() const;
 
