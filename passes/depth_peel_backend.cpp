@@ -937,7 +937,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   if (m.cfg.profile) {
     std::map<std::string, double> sums;
     for (const auto& p : gpu) sums[p.pass] += p.gpu_milliseconds;
-    for (const auto& [name, msec] : sums) m.timings.push_back({"gpu_" + name, msec});
+    for (const auto& [name, msec] : sums) m.timings.push_back({"gpu_" + name, msec, true});
   }
   return out;
 }

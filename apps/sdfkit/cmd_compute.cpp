@@ -89,8 +89,8 @@ void add_compute_command(CLI::App& app) {
     std::printf("backend %s on %s\n", r.backend.c_str(), r.device.c_str());
     double total = 0;
     for (const StageTiming& s : r.stages) {
-      std::printf("  %-16s %10.1f ms\n", s.stage.c_str(), s.milliseconds);
-      total += s.milliseconds;
+      std::printf("  %-16s %10.1f ms%s\n", s.stage.c_str(), s.milliseconds, s.nested ? " (device pass, counted in its stage)" : "");
+      if (!s.nested) total += s.milliseconds;
     }
     std::printf("  %-16s %10.1f ms\n", "total", total);
     std::printf("SDF min %g  median %g  mean %g  max %g (model units); %zu of %zu points filled\n",

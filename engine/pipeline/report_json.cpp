@@ -9,7 +9,7 @@ std::string report_to_json(const ComputeReport& r, const std::string& error, con
   double total = 0;
   for (const StageTiming& s : r.stages) {
     stages[s.stage] = s.milliseconds;
-    total += s.milliseconds;
+    if (!s.nested) total += s.milliseconds;
   }
   nlohmann::json j = {
       {"input", r.input},

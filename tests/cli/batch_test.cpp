@@ -2,6 +2,7 @@
 #include "scratch.hpp"
 
 #include "sdfkit/batch.hpp"
+#include "sdfkit/pipeline.hpp"
 #include "sdfkit/core/error.hpp"
 
 #include <gtest/gtest.h>
@@ -75,4 +76,14 @@ TEST(BatchPlanOutputs, CollidingStemsGetAStableSuffix) {
   EXPECT_NE(out[0], out[1]);
   EXPECT_EQ(out[2], "/out/y.glb");
   EXPECT_EQ(plan_outputs({"/p/a/x.off", "/p/b/x.off"}, "/out", "glb"), std::vector<std::string>(out.begin(), out.begin() + 2));
+}
+
+// The JSON report's total adds the host stages only: a nested device-pass time ("gpu_*", part
+// of a host stage) is listed but not counted twice.
+TEST(ComputeReportJson, TotalSkipsNestedStages) {
+  sdfkit::ComputeReport r;
+  r.stages = {{"load", 2.0}, {"lists_and_resolve", 10.0}, {"gpu_fragment_lists", 9.0, true}};
+  const std::string text = sdfkit::report_to_json(r);
+  EXPECT_NE(text.find("\"gpu_fragment_lists\": 9.0"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"total_ms\": 12.0"), std::string::npos) << text;
 }

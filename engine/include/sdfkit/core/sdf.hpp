@@ -64,6 +64,8 @@ std::vector<float> normalized(std::span<const float> values);
 struct StageTiming {
   std::string stage;  // "octree_build", "upload", "trace_gather", "peel", ...
   double milliseconds = 0.0;
+  // A part of another stage (the device time of one pass, "gpu_*"), not added to totals.
+  bool nested = false;
 };
 
 // Every backend implements this. A backend object is a session: it keeps its device context,
