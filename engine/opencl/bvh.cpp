@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <future>
 #include <limits>
 #include <string>
 
@@ -16,6 +17,8 @@ namespace {
 
 constexpr int kBins = 16;
 constexpr int kMedianBelowDepth = 40;
+// Meshes with at least this many triangles build the root's two subtrees concurrently.
+constexpr std::size_t kParallelBelow = 16384;
 
 struct Box {
   glm::vec3 lo{std::numeric_limits<float>::max()};
@@ -36,64 +39,75 @@ struct Box {
   }
 };
 
+// Where a node's triangles go: a leaf, or two children split at `mid` (items partitioned).
+struct Split {
+  Box bounds;
+  bool leaf = true;
+  std::size_t mid = 0;
+};
+
+// Nodes of one subtree, depth-first, indices local to `nodes`.
+struct Subtree {
+  std::vector<BvhNode> nodes;
+  int depth = 0;
+  std::size_t leaf_count = 0;
+};
+
 struct Builder {
   BvhParams params;
   std::vector<Box> boxes;           // per face
   std::vector<glm::vec3> centroid;  // per face (of its box)
   std::vector<std::uint32_t> items;  // face indices being partitioned
-  Bvh out;
 
-  // Fills node `index` with items [begin, end).
-  void build(std::uint32_t index, std::size_t begin, std::size_t end, int depth) {
-    out.depth = std::max(out.depth, depth);
-    Box bounds, cbounds;
+  // Bounds of items [begin, end) and the split the SAH (or the object median) chooses; a split
+  // partitions the range in place. Subtrees over disjoint ranges may be built concurrently.
+  Split choose(std::size_t begin, std::size_t end, int depth) {
+    Split s;
+    Box cbounds;
     for (std::size_t i = begin; i < end; ++i) {
-      bounds.grow(boxes[items[i]]);
+      s.bounds.grow(boxes[items[i]]);
       cbounds.grow(centroid[items[i]]);
     }
     const std::size_t n = end - begin;
-    BvhNode& node = out.nodes[index];
-    node.min = bounds.empty() ? glm::vec3(0.0f) : bounds.lo;
-    node.max = bounds.empty() ? glm::vec3(0.0f) : bounds.hi;
-    const auto make_leaf = [&] {
-      BvhNode& leaf = out.nodes[index];
-      leaf.first_or_second = static_cast<std::uint32_t>(begin);
-      leaf.count = BvhNode::kLeafBit | static_cast<std::uint32_t>(n);
-      ++out.leaf_count;
-    };
-    if (n <= 1) return make_leaf();
-
+    if (n <= 1) return s;
     std::size_t mid = begin;
     const glm::vec3 extent = cbounds.hi - cbounds.lo;
     const bool flat = !(extent.x > 0.0f || extent.y > 0.0f || extent.z > 0.0f);
     if (!flat && depth < kMedianBelowDepth) {
-      // Binned SAH over all three axes.
+      // Binned SAH over the three axes, binned in one pass over the triangles.
+      std::array<std::array<Box, kBins>, 3> bin_box{};
+      std::array<std::array<std::size_t, kBins>, 3> bin_count{};
+      glm::vec3 scale(0.0f);
+      for (int axis = 0; axis < 3; ++axis)
+        if (extent[axis] > 0.0f) scale[axis] = kBins / extent[axis];
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t f = items[i];
+        const glm::vec3 rel = (centroid[f] - cbounds.lo) * scale;
+        for (int axis = 0; axis < 3; ++axis) {
+          const auto b = static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(rel[axis])));
+          bin_box[static_cast<std::size_t>(axis)][b].grow(boxes[f]);
+          ++bin_count[static_cast<std::size_t>(axis)][b];
+        }
+      }
       float best_cost = std::numeric_limits<float>::max();
       int best_axis = -1, best_split = 0;
       for (int axis = 0; axis < 3; ++axis) {
         if (!(extent[axis] > 0.0f)) continue;
-        std::array<Box, kBins> bin_box{};
-        std::array<std::size_t, kBins> bin_count{};
-        const float scale = kBins / extent[axis];
-        for (std::size_t i = begin; i < end; ++i) {
-          const std::uint32_t f = items[i];
-          const int b = std::min(kBins - 1, static_cast<int>((centroid[f][axis] - cbounds.lo[axis]) * scale));
-          bin_box[static_cast<std::size_t>(b)].grow(boxes[f]);
-          ++bin_count[static_cast<std::size_t>(b)];
-        }
+        const auto& bb = bin_box[static_cast<std::size_t>(axis)];
+        const auto& bc = bin_count[static_cast<std::size_t>(axis)];
         std::array<float, kBins> right_cost{};
         Box acc;
         std::size_t count = 0;
         for (int b = kBins - 1; b > 0; --b) {
-          acc.grow(bin_box[static_cast<std::size_t>(b)]);
-          count += bin_count[static_cast<std::size_t>(b)];
+          acc.grow(bb[static_cast<std::size_t>(b)]);
+          count += bc[static_cast<std::size_t>(b)];
           right_cost[static_cast<std::size_t>(b)] = acc.half_area() * static_cast<float>(count);
         }
         acc = Box{};
         count = 0;
         for (int b = 0; b < kBins - 1; ++b) {
-          acc.grow(bin_box[static_cast<std::size_t>(b)]);
-          count += bin_count[static_cast<std::size_t>(b)];
+          acc.grow(bb[static_cast<std::size_t>(b)]);
+          count += bc[static_cast<std::size_t>(b)];
           const float cost = acc.half_area() * static_cast<float>(count) + right_cost[static_cast<std::size_t>(b) + 1];
           if (count > 0 && count < n && cost < best_cost) {
             best_cost = cost;
@@ -104,21 +118,19 @@ struct Builder {
       }
       // SAH: a split costs one traversal step plus its children's expected triangle tests.
       const float leaf_cost = static_cast<float>(n);
-      const float split_cost = 1.0f + best_cost / std::max(bounds.half_area(), 1e-30f);
-      if (n <= static_cast<std::size_t>(params.leaf_size) && (best_axis < 0 || split_cost >= leaf_cost))
-        return make_leaf();
+      const float split_cost = 1.0f + best_cost / std::max(s.bounds.half_area(), 1e-30f);
+      if (n <= static_cast<std::size_t>(params.leaf_size) && (best_axis < 0 || split_cost >= leaf_cost)) return s;
       if (best_axis >= 0) {
-        const float scale = kBins / extent[best_axis];
+        const float sc = scale[best_axis], lo = cbounds.lo[best_axis];
         const auto it = std::partition(items.begin() + static_cast<std::ptrdiff_t>(begin),
                                        items.begin() + static_cast<std::ptrdiff_t>(end),
                                        [&](std::uint32_t f) {
-                                         const int b = std::min(kBins - 1, static_cast<int>((centroid[f][best_axis] - cbounds.lo[best_axis]) * scale));
-                                         return b <= best_split;
+                                         return std::min(kBins - 1, static_cast<int>((centroid[f][best_axis] - lo) * sc)) <= best_split;
                                        });
         mid = static_cast<std::size_t>(it - items.begin());
       }
     } else if (n <= static_cast<std::size_t>(params.leaf_size)) {
-      return make_leaf();
+      return s;
     }
     if (mid == begin || mid == end) {
       // Object median along the longest centroid axis (or by index when all coincide).
@@ -131,14 +143,74 @@ struct Builder {
                          return centroid[a][axis] != centroid[b][axis] ? centroid[a][axis] < centroid[b][axis] : a < b;
                        });
     }
-    const auto left = static_cast<std::uint32_t>(out.nodes.size());
-    out.nodes.emplace_back();
-    build(left, begin, mid, depth + 1);
-    const auto right = static_cast<std::uint32_t>(out.nodes.size());
-    out.nodes.emplace_back();
-    out.nodes[index].first_or_second = right;
-    out.nodes[index].count = 0;
-    build(right, mid, end, depth + 1);
+    s.leaf = false;
+    s.mid = mid;
+    return s;
+  }
+
+  // Fills node `index` of `t` (already allocated) with items [begin, end), depth-first.
+  void build(Subtree& t, std::uint32_t index, std::size_t begin, std::size_t end, int depth) {
+    t.depth = std::max(t.depth, depth);
+    const Split s = choose(begin, end, depth);
+    set_bounds(t.nodes[index], s.bounds);
+    if (s.leaf) return make_leaf(t, index, begin, end);
+    const auto left = static_cast<std::uint32_t>(t.nodes.size());
+    t.nodes.emplace_back();
+    build(t, left, begin, s.mid, depth + 1);
+    const auto right = static_cast<std::uint32_t>(t.nodes.size());
+    t.nodes.emplace_back();
+    t.nodes[index].first_or_second = right;
+    t.nodes[index].count = 0;
+    build(t, right, s.mid, end, depth + 1);
+  }
+
+  static void set_bounds(BvhNode& node, const Box& b) {
+    node.min = b.empty() ? glm::vec3(0.0f) : b.lo;
+    node.max = b.empty() ? glm::vec3(0.0f) : b.hi;
+  }
+  static void make_leaf(Subtree& t, std::uint32_t index, std::size_t begin, std::size_t end) {
+    t.nodes[index].first_or_second = static_cast<std::uint32_t>(begin);
+    t.nodes[index].count = BvhNode::kLeafBit | static_cast<std::uint32_t>(end - begin);
+    ++t.leaf_count;
+  }
+
+  // The whole tree. Large meshes: the root's two subtrees are built on two threads into their
+  // own arrays and spliced behind the root, which gives the sequential depth-first layout.
+  Bvh build_all() {
+    Bvh out;
+    const std::size_t n = items.size();
+    Subtree whole;
+    whole.nodes.emplace_back();
+    const Split s = n >= kParallelBelow ? choose(0, n, 0) : Split{};
+    if (n < kParallelBelow || s.leaf) {
+      build(whole, 0, 0, n, 0);
+    } else {
+      set_bounds(whole.nodes[0], s.bounds);
+      Subtree left, right;
+      left.nodes.emplace_back();
+      right.nodes.emplace_back();
+      auto done = std::async(std::launch::async, [&] { build(right, 0, s.mid, n, 1); });
+      build(left, 0, 0, s.mid, 1);
+      done.get();
+      const auto splice = [&](const Subtree& t) {
+        const auto offset = static_cast<std::uint32_t>(whole.nodes.size());
+        for (BvhNode node : t.nodes) {
+          if (!node.is_leaf()) node.first_or_second += offset;
+          whole.nodes.push_back(node);
+        }
+        whole.depth = std::max(whole.depth, t.depth);
+        whole.leaf_count += t.leaf_count;
+      };
+      whole.nodes.reserve(1 + left.nodes.size() + right.nodes.size());
+      splice(left);
+      whole.nodes[0].first_or_second = static_cast<std::uint32_t>(whole.nodes.size());
+      splice(right);
+    }
+    out.nodes = std::move(whole.nodes);
+    out.depth = whole.depth;
+    out.leaf_count = whole.leaf_count;
+    out.order = std::move(items);
+    return out;
   }
 };
 
@@ -147,7 +219,7 @@ struct Builder {
 Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
   if (params.leaf_size < 1)
     throw InputError("the BVH leaf size must be at least 1, got " + std::to_string(params.leaf_size));
-  Builder b{params, {}, {}, {}, {}};
+  Builder b{params, {}, {}, {}};
   const auto degenerate = degenerate_faces(mesh);
   b.boxes.resize(mesh.triangles.size());
   b.centroid.resize(mesh.triangles.size());
@@ -167,11 +239,7 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     b.boxes[f].lo -= pad;
     b.boxes[f].hi += pad;
   }
-  b.out.nodes.reserve(2 * b.items.size() / static_cast<std::size_t>(params.leaf_size) + 1);
-  b.out.nodes.emplace_back();
-  b.build(0, 0, b.items.size(), 0);
-  b.out.order = std::move(b.items);
-  return std::move(b.out);
+  return b.build_all();
 }
 
 }  // namespace sdfkit::cl

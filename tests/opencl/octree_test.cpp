@@ -125,11 +125,11 @@ TEST(Octree, RejectsBadParameters) {
 }
 
 // The BVH: every non-degenerate triangle in exactly one leaf, boxes nest and contain their
-// triangles, depth within the device stack.
-TEST(Bvh, LeavesPartitionTheTrianglesAndBoxesNest) {
+// triangles, depth within the device stack. A small mesh (built on one thread) and one large
+// enough for the root's subtrees to be built on two threads and spliced.
+void expect_valid_bvh(Mesh mesh) {
   using sdfkit::cl::Bvh;
   using sdfkit::cl::BvhNode;
-  Mesh mesh = shapes::torus(2.0f, 0.6f, 48, 24);
   mesh.triangles.push_back({0, 0, 1});  // degenerate
   const Bvh b = sdfkit::cl::build_bvh(mesh, {4});
   const auto degenerate = degenerate_faces(mesh);
@@ -164,4 +164,9 @@ TEST(Bvh, LeavesPartitionTheTrianglesAndBoxesNest) {
   EXPECT_EQ(depth, b.depth);
   EXPECT_LT(depth, 72);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) EXPECT_EQ(seen[f], degenerate[f] ? 0 : 1) << f;
+}
+
+TEST(Bvh, LeavesPartitionTheTrianglesAndBoxesNest) {
+  expect_valid_bvh(shapes::torus(2.0f, 0.6f, 48, 24));    // 2304 triangles
+  expect_valid_bvh(shapes::torus(2.0f, 0.6f, 192, 96));  // 36864 triangles: two threads
 }
