@@ -129,6 +129,15 @@ std::vector<NormalBin> bin_normals(std::span<const glm::vec4> normals, int bins,
     const double phi = std::fmod(i * kGoldenAngle, 2.0 * M_PI);
     axes[static_cast<std::size_t>(i)] = glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
   }
+  // Draw order: latitude bands, by azimuth within a band, so the groups a camera keeps (a cap
+  // of directions) form a few runs, one draw each (about 8 per camera at 128 groups, against
+  // 34 in Fibonacci order).
+  const int bands = std::max(2, static_cast<int>(std::lround(std::sqrt(bins / 2.0))));
+  const auto band_key = [&](const glm::dvec3& a) {
+    const int band = std::min(bands - 1, static_cast<int>((1.0 - a.z) / 2.0 * bands));
+    return std::pair(band, std::atan2(a.y, a.x));
+  };
+  std::sort(axes.begin(), axes.end(), [&](const glm::dvec3& a, const glm::dvec3& b) { return band_key(a) < band_key(b); });
   std::vector<std::uint32_t> bin_of(normals.size());
   std::vector<double> min_cos(axes.size(), 1.0);
   std::vector<std::uint32_t> counts(axes.size() + 1, 0);
