@@ -17,6 +17,7 @@ layout(push_constant) uniform Push {
 } pc;
 
 layout(location = 0) flat in int in_layer;
+layout(location = 1) flat in uint in_triangle;  // draw-order index (not gl_PrimitiveID: see the backend)
 layout(location = 0) out uvec2 out_layer_texel;
 
 void main() {
@@ -25,5 +26,5 @@ void main() {
     const uint prev = texelFetch(previous_layer, ivec3(ivec2(gl_FragCoord.xy), in_layer), 0).x;
     if (z <= uintBitsToFloat(prev) + pc.epsilon) discard;
   }
-  out_layer_texel = uvec2(floatBitsToUint(z), encode_normal(normals[gl_PrimitiveID].xyz));
+  out_layer_texel = uvec2(floatBitsToUint(z), encode_normal(normals[in_triangle].xyz));
 }

@@ -1,5 +1,5 @@
 #version 450
-// Peel pass, vertex stage. Indexed draw of the non-degenerate triangles; instance i is camera
+// Peel pass, vertex stage. Non-indexed draw of the non-degenerate triangles' corners; instance i is camera
 // camera_base + i. The pass draws twice: front faces (back faces culled) into layer 2i, then back
 // faces (front faces culled) into layer 2i + 1.
 #extension GL_ARB_shader_viewport_layer_array : require
@@ -18,6 +18,7 @@ layout(push_constant) uniform Push {
 } pc;
 
 layout(location = 0) flat out int out_layer;
+layout(location = 1) flat out uint out_triangle;  // draw-order index of the triangle
 
 void main() {
   const Camera cam = cams[pc.camera_base + uint(gl_InstanceIndex)];
@@ -26,4 +27,5 @@ void main() {
   const int layer = 2 * gl_InstanceIndex + int(pc.back);
   gl_Layer = layer;
   out_layer = layer;
+  out_triangle = uint(gl_VertexIndex) / 3u;
 }

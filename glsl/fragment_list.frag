@@ -16,10 +16,10 @@ layout(push_constant) uniform Push {
   uint camera_base;
   int resolution;
   uint capacity;  // nodes
-  uint first_primitive;  // draw-order index of the draw's first triangle
 } pc;
 
 layout(location = 0) flat in uint in_camera;
+layout(location = 1) flat in uint in_triangle;  // draw-order index (not gl_PrimitiveID: see the backend)
 layout(location = 0) out uint out_unused;  // the pass's attachment only sets the render area
 
 void main() {
@@ -29,6 +29,6 @@ void main() {
   const ivec2 px = ivec2(gl_FragCoord.xy);
   const uint head = (in_camera * uint(pc.resolution) + uint(px.y)) * uint(pc.resolution) + uint(px.x);
   nodes[kNodeWords * node] = floatBitsToUint(gl_FragCoord.z) | (gl_FrontFacing ? kFrontBit : 0u);
-  nodes[kNodeWords * node + 1u] = encode_normal(normals[pc.first_primitive + uint(gl_PrimitiveID)].xyz);
+  nodes[kNodeWords * node + 1u] = encode_normal(normals[in_triangle].xyz);
   nodes[kNodeWords * node + 2u] = atomicExchange(heads[head], node);
 }

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstddef>
 #include <cstring>
 #include <map>
 #include <span>
@@ -63,7 +62,6 @@ struct ListPush {
   std::uint32_t camera_base;
   std::int32_t resolution;
   std::uint32_t capacity;
-  std::uint32_t first_primitive;  // draw-order index of the draw's first triangle
 };
 struct ResolvePush {
   glm::vec4 center_scale;
@@ -239,8 +237,11 @@ struct DepthPeelBackend::Impl {
   bool front_layers = true;  // peel front layers for the current mesh
   std::vector<std::uint32_t> drawn;  // non-degenerate triangles, in index-buffer order
   std::vector<NormalBin> bins;       // FragmentLists on closed meshes: drawn triangles by normal
-  Buffer position_buffer;            // V x vec3
-  Buffer index_buffer;               // drawn x 3
+  // The drawn triangles' corners, three vec3 per triangle in draw order. Non-indexed draws: the
+  // vertex stage passes gl_VertexIndex / 3 to the fragment stage as the triangle's index. With
+  // gl_PrimitiveID instead, llvmpipe runs its primitive assembler, which reallocates an array
+  // per primitive (~20 % of the queue thread's time at 128 views).
+  Buffer corner_buffer;
   Buffer normal_buffer;              // drawn x vec4 (outward unit normal)
   glm::vec3 center{0.0f};
   float radius = 1.0f;
@@ -394,7 +395,7 @@ void DepthPeelBackend::Impl::grow_nodes(std::size_t capacity) {
 void DepthPeelBackend::Impl::upload_geometry(std::span<const glm::vec3> positions) {
   // Degenerate triangles are never drawn (never ray targets); the rest keep their order.
   drawn.clear();
-  std::vector<std::uint32_t> indices;
+  std::vector<glm::vec3> corners;
   std::vector<glm::vec4> normals;
   for (std::size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
@@ -418,15 +419,15 @@ void DepthPeelBackend::Impl::upload_geometry(std::span<const glm::vec3> position
     drawn = std::move(sorted_drawn);
     normals = std::move(sorted_normals);
   }
-  indices.reserve(3 * drawn.size());
-  for (std::uint32_t f : drawn) indices.insert(indices.end(), triangles[f].begin(), triangles[f].end());
+  corners.reserve(3 * drawn.size());
+  for (std::uint32_t f : drawn)
+    for (std::uint32_t v : triangles[f]) corners.push_back(positions[v]);
   auto upload = [&](Buffer& buf, const void* data, std::size_t bytes, VkBufferUsageFlags usage) {
     const std::size_t alloc = std::max<std::size_t>(bytes, 16);
     if (!buf.buffer || buf.size < alloc) buf = create_buffer(*ctx, alloc, usage, MemoryUse::Upload);
     if (bytes) std::memcpy(buf.mapped(), data, bytes);
   };
-  upload(position_buffer, positions.data(), positions.size_bytes(), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  upload(index_buffer, indices.data(), indices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  upload(corner_buffer, corners.data(), corners.size() * sizeof(glm::vec3), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
   upload(normal_buffer, normals.data(), normals.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
   // Bounding sphere: box centre, farthest vertex (only vertices used by triangles count).
@@ -529,7 +530,7 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
   const glm::vec4 center_scale(center, 1.0f / (radius * kFrameMargin));
   const auto res = static_cast<std::uint32_t>(cfg.resolution);
   const ImageInfo target_info{kListTargetFormat, res, res, 1};
-  const auto index_count = static_cast<std::uint32_t>(3 * drawn.size());
+  const auto corner_count = static_cast<std::uint32_t>(3 * drawn.size());
   const auto groups = static_cast<std::uint32_t>((n + 63) / 64);
   const Pipeline& raster = front_layers ? list_all : list_back;
   dropped = 0;
@@ -539,8 +540,7 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
     RenderGraph g;
     auto cnt = g.import_buffer("counts", counts.size, {counts.get()});
     auto smp = g.import_buffer("samples", samples.size, {samples.get()});
-    auto pos = g.import_buffer("positions", position_buffer.size, {position_buffer.get()});
-    auto idx = g.import_buffer("indices", index_buffer.size, {index_buffer.get()});
+    auto pos = g.import_buffer("corners", corner_buffer.size, {corner_buffer.get()});
     auto hd = g.import_buffer("list_heads", heads.size, {heads.get()});
     auto nd = g.import_buffer("list_nodes", nodes.size, {nodes.get()});
     auto ctr = g.import_buffer("list_counter", counter.size, {counter.get()});
@@ -559,30 +559,27 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
     auto list = g.add_pass("fragment_lists", PassKind::Graphics);
     list.color(g.create_image("list_target", target_info), LoadOp::DontCare);
     list.vertex(pos);
-    list.index(idx);
     hd = list.atomic(hd);
     ctr = list.atomic(ctr);
     nd = list.storage_write(nd);
     const ListPush lp{center_scale, static_cast<std::uint32_t>(base), cfg.resolution,
-                      static_cast<std::uint32_t>(node_capacity), 0};
+                      static_cast<std::uint32_t>(node_capacity)};
     list.execute([&, lp, count, base](PassContext& pc) {
       const VkDeviceSize zero = 0;
       const VkBuffer vb = pc.buffer(pos);
       vkCmdBindVertexBuffers(pc.cmd, 0, 1, &vb, &zero);
-      vkCmdBindIndexBuffer(pc.cmd, pc.buffer(idx), 0, VK_INDEX_TYPE_UINT32);
       vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, raster.get());
       vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, raster.layout.get(), 0, 1, &list_set, 0,
                               nullptr);
       vkCmdPushConstants(pc.cmd, raster.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                          sizeof(lp), &lp);
       if (bins.empty()) {
-        vkCmdDrawIndexed(pc.cmd, index_count, count, 0, 0, 0);
-        submitted += static_cast<std::size_t>(index_count / 3) * count;
+        vkCmdDraw(pc.cmd, corner_count, count, 0, 0);
+        submitted += static_cast<std::size_t>(corner_count / 3) * count;
         return;
       }
       // One draw per run of consecutive groups that the camera does not skip; the instance
       // index still names the camera within the batch.
-      constexpr auto kFirstOffset = static_cast<std::uint32_t>(offsetof(ListPush, first_primitive));
       for (std::uint32_t c = 0; c < count; ++c) {
         const glm::vec3 view(cameras[static_cast<std::size_t>(base) + c].dir);
         for (std::size_t b = 0; b < bins.size();) {
@@ -594,9 +591,7 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
           std::uint32_t end = first + bins[b].count;
           for (++b; b < bins.size() && !(glm::dot(bins[b].dir, view) < bins[b].skip_below); ++b)
             end = bins[b].first + bins[b].count;
-          vkCmdPushConstants(pc.cmd, raster.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
-                             kFirstOffset, sizeof(first), &first);
-          vkCmdDrawIndexed(pc.cmd, 3 * (end - first), 1, 3 * first, 0, c);
+          vkCmdDraw(pc.cmd, 3 * (end - first), 1, 3 * first, c);
           submitted += end - first;
         }
       }
@@ -800,7 +795,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   const ImageInfo ring_info{kLayerFormat, res, res, static_cast<std::uint32_t>(2 * m.batch)};
   const ImageInfo depth_info{kDepthFormat, res, res, static_cast<std::uint32_t>(2 * m.batch)};
   const float cos_half = std::cos(0.5f * options.cone_degrees * static_cast<float>(M_PI) / 180.0f);
-  const auto index_count = static_cast<std::uint32_t>(3 * m.drawn.size());
+  const auto corner_count = static_cast<std::uint32_t>(3 * m.drawn.size());
   const auto groups = static_cast<std::uint32_t>((n + 63) / 64);
   std::vector<PassTiming> gpu;
   bool cap_hit = false;
@@ -831,8 +826,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
       }
       auto depth = g.create_image("depth", depth_info);
       auto cnt = g.import_buffer("counts", m.counts.size, {m.counts.get()});
-      auto pos = g.import_buffer("positions", m.position_buffer.size, {m.position_buffer.get()});
-      auto idx = g.import_buffer("indices", m.index_buffer.size, {m.index_buffer.get()});
+      auto pos = g.import_buffer("corners", m.corner_buffer.size, {m.corner_buffer.get()});
       auto smp = g.import_buffer("samples", m.samples.size, {m.samples.get()});
 
       if (base == 0 && layer == 1) {
@@ -855,7 +849,6 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
         auto peel = g.add_pass("peel", PassKind::Graphics);
         peel.sampled(rings[prev]);
         peel.vertex(pos);
-        peel.index(idx);
         depth = peel.depth(depth, LoadOp::Clear, 1.0f);
         rings[cur] = peel.color(rings[cur], LoadOp::Clear, VkClearColorValue{.uint32 = {0x40000000u, 0, 0, 0}});
         peel.side_effect();  // the occlusion query
@@ -864,7 +857,6 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
           const VkDeviceSize zero = 0;
           const VkBuffer vb = pc.buffer(pos);
           vkCmdBindVertexBuffers(pc.cmd, 0, 1, &vb, &zero);
-          vkCmdBindIndexBuffer(pc.cmd, pc.buffer(idx), 0, VK_INDEX_TYPE_UINT32);
           vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m.peel_front.layout.get(), 0, 1,
                                   &m.peel_sets[prev], 0, nullptr);
           vkCmdBeginQuery(pc.cmd, m.occlusion.get(), static_cast<std::uint32_t>(s), 0);
@@ -875,7 +867,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
             vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p->get());
             vkCmdPushConstants(pc.cmd, p->layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                                0, sizeof(push), &push);
-            vkCmdDrawIndexed(pc.cmd, index_count, count, 0, 0, 0);
+            vkCmdDraw(pc.cmd, corner_count, count, 0, 0);
           }
           vkCmdEndQuery(pc.cmd, m.occlusion.get(), static_cast<std::uint32_t>(s));
         });
