@@ -206,7 +206,6 @@ GraphicsPipelineDescription mesh_raster_pipeline(std::string_view vertex_shader,
 std::vector<DeviceInfo> list_devices_for_depth_peel() {
   DeviceRequirements req;
   req.shader_output_layer = true;
-  req.geometry_shader = true;
   return list_devices(req);
 }
 
@@ -287,7 +286,6 @@ DepthPeelBackend::Impl::Impl(const DepthPeelConfig& c)
         cc.device = c.device;
         cc.validation = c.validation;
         cc.requirements.shader_output_layer = true;
-        cc.requirements.geometry_shader = true;
         return std::make_unique<Context>(cc);
       }()),
       transients(*ctx) {
