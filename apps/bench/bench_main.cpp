@@ -4,6 +4,7 @@
 #include "bench_runner.hpp"
 
 #include "sdfkit/io/asset.hpp"
+#include "sdfkit/process.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -39,6 +40,7 @@ std::string self_dir() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  sdfkit::keep_freed_heap();
   CLI::App app{"sdfkit-bench: time the SDF backends against the Embree reference, CGAL and MeshLab"};
   BenchOptions o;
   std::vector<std::string> meshes;

@@ -3,11 +3,13 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/log.hpp"
+#include "sdfkit/process.hpp"
 
 #include <cstdio>
 #include <new>
 
 int main(int argc, char** argv) {
+  sdfkit::keep_freed_heap();
   CLI::App app{"sdfkit: the Shape Diameter Function of triangle meshes, on the GPU"};
   app.set_version_flag("--version", std::string("sdfkit ") + SDFKIT_VERSION);
   app.require_subcommand(1);
