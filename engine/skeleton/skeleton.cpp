@@ -5,6 +5,7 @@
 
 #include "bvh.hpp"
 #include "laplacian.hpp"
+#include "simplify.hpp"
 #include "surgery.hpp"
 #include "validate.hpp"
 
@@ -227,18 +228,45 @@ void validate(const SkeletonOptions& o) {
     throw InputError("skeleton collapse cost weights must be >= 0 and not both 0");
 }
 
-}  // namespace
+// A contracted proxy of the input (extract() with ContractionOptions::proxy_vertices): the
+// surgery runs on it, and its nodes' members are expanded to the input vertices merged into
+// each proxy vertex.
+struct ContractedProxy {
+  const Mesh& contracted;                       // the contracted proxy
+  const std::vector<std::uint32_t>& vertex_map;  // per input vertex: its proxy vertex
+};
 
-Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
-                        const SkeletonOptions& options) {
-  validate(options);
-  detail::require_closed(original, "skeleton extraction");
+// Connectivity surgery on the contracted input, or on the contracted proxy with per proxy
+// vertex the mean local radius and centre point of its input vertices; node members are input
+// vertices either way.
+detail::CurveGraph surgery(const Surface& surface, const std::vector<float>& local_radius,
+                           const ContractedProxy* proxy, const detail::SurgeryOptions& so) {
+  if (proxy == nullptr) return detail::collapse_to_curves(surface.contracted, local_radius, surface.centre, so);
+  const std::size_t m = proxy->contracted.positions.size();
+  std::vector<std::vector<std::uint32_t>> inputs(m);
+  for (std::uint32_t k = 0; k < proxy->vertex_map.size(); ++k) inputs[proxy->vertex_map[k]].push_back(k);
+  std::vector<float> radius(m, 0.0f);
+  std::vector<glm::vec3> centre(m);
+  for (std::uint32_t p = 0; p < m; ++p) {
+    double r = 0.0;
+    glm::dvec3 c(0.0);
+    for (std::uint32_t k : inputs[p]) r += local_radius[k], c += glm::dvec3(surface.centre[k]);
+    const double count = std::max<double>(1.0, static_cast<double>(inputs[p].size()));
+    radius[p] = static_cast<float>(r / count);
+    centre[p] = inputs[p].empty() ? proxy->contracted.positions[p] : glm::vec3(c / count);
+  }
+  detail::CurveGraph graph = detail::collapse_to_curves(proxy->contracted, radius, centre, so);
+  for (std::vector<std::uint32_t>& members : graph.members) {
+    std::vector<std::uint32_t> expanded;
+    for (std::uint32_t p : members) expanded.insert(expanded.end(), inputs[p].begin(), inputs[p].end());
+    members = std::move(expanded);
+  }
+  return graph;
+}
+
+Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+               const SkeletonOptions& options, const ContractedProxy* proxy) {
   const std::size_t n = original.positions.size();
-  if (contracted.positions.size() != n || contracted.triangles != original.triangles)
-    throw InputError("the contracted mesh does not match the original's connectivity");
-  if (!sdf.empty() && sdf.size() != n)
-    throw InputError("the SDF has " + std::to_string(sdf.size()) + " values for " +
-                     std::to_string(n) + " vertices");
 
   const double diag = bounding_box(original.positions).diagonal();
   std::vector<float> local_radius(n);
@@ -253,8 +281,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   Stopwatch watch;
   const Surface surface(original, contracted, sdf);
   watch.lap("BVH and centre points");
-  const detail::CurveGraph graph =
-      detail::collapse_to_curves(contracted, local_radius, surface.centre, so);
+  const detail::CurveGraph graph = surgery(surface, local_radius, proxy, so);
   watch.lap("connectivity surgery");
 
   const std::size_t curve_nodes = graph.positions.size();
@@ -426,20 +453,82 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   return sk;
 }
 
+}  // namespace
+
+Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+                        const SkeletonOptions& options) {
+  validate(options);
+  detail::require_closed(original, "skeleton extraction");
+  const std::size_t n = original.positions.size();
+  if (contracted.positions.size() != n || contracted.triangles != original.triangles)
+    throw InputError("the contracted mesh does not match the original's connectivity");
+  if (!sdf.empty() && sdf.size() != n)
+    throw InputError("the SDF has " + std::to_string(sdf.size()) + " values for " +
+                     std::to_string(n) + " vertices");
+  return build(original, contracted, sdf, options, nullptr);
+}
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+}  // namespace
+
 Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
                  const SkeletonOptions& options) {
   validate(options);
-  ContractionResult c = contract(mesh, backend, contraction);
-  std::vector<float> sdf = std::move(c.first_sdf);
+  detail::require_closed(mesh, "skeleton extraction");
+  using Clock = std::chrono::steady_clock;
+  Skeleton::Timings seconds;
+  SdfOptions so = contraction.sdf;
+  so.domain = SdfDomain::Vertex;
+  const std::size_t limit = contraction.proxy_vertices;
+  const bool use_proxy = limit > 0 && mesh.positions.size() > limit;
+
+  // The proxy path: contract a simplified copy, carry every input vertex along with the proxy
+  // vertex it was merged into, and build the skeleton for the input.
+  auto t = Clock::now();
+  detail::Simplified proxy;
+  if (use_proxy) {
+    proxy = detail::simplify(mesh, limit);
+    seconds.simplify = seconds_since(t);
+    log_debug("skeleton: proxy of " + std::to_string(proxy.mesh.positions.size()) + " vertices (" +
+              std::to_string(proxy.collapses) + " collapses, " + std::to_string(proxy.refused) +
+              " refused) in " + std::to_string(1e3 * seconds.simplify) + " ms");
+  }
+  t = Clock::now();
+  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, contraction);
+  seconds.contraction = seconds_since(t);
+  seconds.contraction_sdf = c.sdf_seconds;
+  seconds.contraction_solve = c.solve_seconds;
+
+  // The input's own SDF at full quality (radii, centre points, grouping, Skeleton::sdf): the
+  // first SDF of the contraction, else measured once here.
+  t = Clock::now();
+  std::vector<float> sdf;
+  if (!use_proxy) sdf = std::move(c.first_sdf);
   if (backend != nullptr && sdf.empty()) {
-    SdfOptions so = contraction.sdf;
-    so.domain = SdfDomain::Vertex;
     backend->set_mesh(mesh);
     sdf = compute_sdf(*backend, mesh, so).values;
+    seconds.input_sdf = seconds_since(t);
   }
-  Skeleton sk = build_skeleton(mesh, c.contracted, sdf, options);
+
+  t = Clock::now();
+  Skeleton sk;
+  if (use_proxy) {
+    Mesh contracted{.positions = std::vector<glm::vec3>(mesh.positions.size()), .triangles = mesh.triangles};
+    for (std::size_t k = 0; k < mesh.positions.size(); ++k)
+      contracted.positions[k] = c.contracted.positions[proxy.vertex_map[k]];
+    const ContractedProxy contracted_proxy{c.contracted, proxy.vertex_map};
+    sk = build(mesh, contracted, sdf, options, &contracted_proxy);
+  } else {
+    sk = build(mesh, c.contracted, sdf, options, nullptr);
+  }
+  seconds.build = seconds_since(t);
   sk.iterations = c.iterations;
+  sk.contracted_vertices = use_proxy ? proxy.mesh.positions.size() : mesh.positions.size();
   sk.sdf = std::move(sdf);
+  sk.seconds = seconds;
   sk.warnings.insert(sk.warnings.begin(), c.warnings.begin(), c.warnings.end());
   return sk;
 }

@@ -20,6 +20,7 @@
 #include "sdfkit/core/sdf.hpp"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
@@ -67,7 +68,20 @@ struct ContractionOptions {
   // grow the area: see ContractionResult::stop_reason).
   double area_ratio_stop = 1e-3;
   int max_iterations = 20;  // hard cap on the iterations (>= 1)
-  SdfOptions sdf;           // options of the SDF recomputed at every iteration (domain: Vertex)
+  // Options of the SDF (domain: Vertex). The first iteration measures it with sdf.rays (that
+  // SDF normalizes the holding weights and, without a proxy, is Skeleton::sdf) ...
+  SdfOptions sdf;
+  // ... and every later iteration recomputes it on the current mesh with this many rays
+  // (0 = sdf.rays): the centering term needs only an approximate thickness. See README.md for
+  // the measurements behind the default.
+  int iteration_rays = 16;
+  // extract(): a mesh with more vertices than this is contracted through a proxy simplified to
+  // this many vertices (manifold-preserving quadric edge collapses that keep closedness and
+  // genus); every input vertex follows the proxy vertex it was merged into, and the skeleton
+  // is still built for the input (nodes hold input vertices, radii, centre points and
+  // visibility from the input's SDF and surface). 0 = always contract the input itself.
+  // contract() ignores it. See README.md for the measurements behind the default.
+  std::size_t proxy_vertices = 1000;
 };
 
 struct ContractionResult {
@@ -82,6 +96,8 @@ struct ContractionResult {
   // failure (also in warnings).
   std::string stop_reason;
   std::vector<std::string> warnings;
+  double sdf_seconds = 0.0;    // wall-clock time in the SDF (update_positions + compute_sdf)
+  double solve_seconds = 0.0;  // wall-clock time building and solving the linear systems
 };
 
 // Contracts `mesh` (closed) by iterated Laplacian smoothing with holding and SDF centering
@@ -122,6 +138,18 @@ struct Skeleton {
   double reliability = 0.0;
   double curve_reliability = 0.0;  // the same for the curve skeleton before sheets were added
   int iterations = 0;              // contraction iterations
+  // Vertices of the mesh that was contracted: the proxy's (ContractionOptions::proxy_vertices)
+  // or the input's.
+  std::size_t contracted_vertices = 0;
+  // Wall-clock seconds per stage of extract() (zero for stages that did not run).
+  struct Timings {
+    double simplify = 0.0;           // building the proxy
+    double contraction_sdf = 0.0;    // SDF recomputed during the contraction
+    double contraction_solve = 0.0;  // linear systems of the contraction
+    double contraction = 0.0;        // the whole contraction (SDF, solves, areas, normals)
+    double input_sdf = 0.0;          // the input's SDF when the contraction did not measure it
+    double build = 0.0;              // surgery, refinement, visibility, sheets
+  } seconds;
   // Per-vertex SDF of the input mesh (model units, gaps filled) with the contraction's SDF
   // options; empty when extract() ran without a backend.
   std::vector<float> sdf;
