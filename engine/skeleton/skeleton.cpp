@@ -5,6 +5,7 @@
 
 #include "bvh.hpp"
 #include "laplacian.hpp"
+#include "parallel.hpp"
 #include "simplify.hpp"
 #include "surgery.hpp"
 #include "validate.hpp"
@@ -53,17 +54,19 @@ struct Surface {
     // otherwise (no SDF, or a vertex on a sharp edge whose cone estimate points past a
     // concavity) an inside point the vertex sees (see seen_inside_point).
     centre.resize(o.positions.size());
-    for (std::uint32_t k = 0; k < o.positions.size(); ++k) {
-      const glm::vec3 u = o.positions[k];
-      if (!sdf.empty()) {
-        const glm::vec3 p = u - 0.5f * sdf[k] * normals[k];
-        if (!bvh.segment_blocked(u, p, k) && bvh.inside(p)) {
-          centre[k] = p;
-          continue;
+    detail::parallel_for(o.positions.size(), [&](std::size_t begin, std::size_t end) {
+      for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
+        const glm::vec3 u = o.positions[k];
+        if (!sdf.empty()) {
+          const glm::vec3 p = u - 0.5f * sdf[k] * normals[k];
+          if (!bvh.segment_blocked(u, p, k) && bvh.inside(p)) {
+            centre[k] = p;
+            continue;
+          }
         }
+        centre[k] = seen_inside_point(k, {u - normals[k], c.positions[k]}).value_or(c.positions[k]);
       }
-      centre[k] = seen_inside_point(k, {u - normals[k], c.positions[k]}).value_or(c.positions[k]);
-    }
+    });
   }
 
   bool sees(std::uint32_t k, const glm::vec3& p) const {
@@ -153,19 +156,17 @@ struct Surface {
   }
 };
 
-// Sheet nodes: the sheet vertices' sheet points (Surface::sheet_point) clustered on a grid of
+// Sheet nodes: the sheet vertices' sheet points (`point`, from Surface::sheet_point) clustered on a grid of
 // cell `spacing` (model units; 0 = one node per vertex). A cluster's node sits at the mean of
 // its sheet points (or, when that is outside the solid, at the member's point closest to it);
 // a member that cannot see it keeps a node of its own at its sheet point, so every sheet vertex
 // sees its node.
 void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in_sheet,
-                     double spacing, std::vector<Node>& nodes,
+                     const std::vector<glm::vec3>& point, double spacing, std::vector<Node>& nodes,
                      std::vector<std::uint32_t>& node_of_vertex) {
   std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> cells;
-  std::vector<glm::vec3> point(in_sheet.size());
   for (std::uint32_t k = 0; k < in_sheet.size(); ++k) {
     if (!in_sheet[k]) continue;
-    point[k] = *surface.sheet_point(k);  // in_sheet only holds vertices that have one
     std::array<std::int64_t, 3> key{static_cast<std::int64_t>(k), 0, 0};
     if (spacing > 0.0)
       for (int a = 0; a < 3; ++a) key[a] = static_cast<std::int64_t>(std::floor(point[k][a] / spacing));
@@ -302,39 +303,54 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
     graph_adjacency[e[0]].push_back(e[1]);
     graph_adjacency[e[1]].push_back(e[0]);
   }
+  // Per vertex, independently (node positions are fixed here): the node it ends with, or
+  // UINT32_MAX when it sees none (then, with sheets on, its sheet point if it has one).
+  std::vector<std::uint32_t> choice(n);
+  std::vector<std::uint8_t> has_sheet_point(n, 0);
+  std::vector<glm::vec3> sheet_point(n);
+  detail::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
+      choice[k] = owner[k];
+      if (surface.sees(k, position[owner[k]])) continue;
+      const glm::vec3 u = original.positions[k];
+      std::vector<std::pair<float, std::uint32_t>> by_distance;
+      for (std::uint32_t c = 0; c < curve_nodes; ++c)
+        if (c != owner[k]) by_distance.push_back({glm::length(position[c] - u), c});
+      const std::size_t nearest = std::min<std::size_t>(kNearestNodes, by_distance.size());
+      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(nearest),
+                        by_distance.end());
+      by_distance.resize(nearest);
+      for (std::uint32_t c : graph_adjacency[owner[k]])
+        by_distance.push_back({glm::length(position[c] - u), c});
+      std::sort(by_distance.begin(), by_distance.end());
+      choice[k] = UINT32_MAX;
+      for (const auto& [d, c] : by_distance)
+        if (surface.sees(k, position[c])) {
+          choice[k] = c;
+          break;
+        }
+      if (choice[k] == UINT32_MAX && options.sheets)
+        if (const auto p = surface.sheet_point(k)) has_sheet_point[k] = 1, sheet_point[k] = *p;
+    }
+  });
+  // Apply in vertex order: a vertex moves to its chosen node; one that sees none stays
+  // (failing) or, with sheets, leaves its curve node and becomes a sheet vertex (below).
   std::vector<std::uint8_t> in_sheet(n, 0);
   std::size_t failing = 0;
+  std::vector<std::vector<std::uint32_t>> moved_in(curve_nodes);
   for (std::uint32_t k = 0; k < n; ++k) {
-    if (surface.sees(k, position[owner[k]])) continue;
-    const glm::vec3 u = original.positions[k];
-    std::vector<std::pair<float, std::uint32_t>> by_distance;
-    for (std::uint32_t c = 0; c < curve_nodes; ++c)
-      if (c != owner[k]) by_distance.push_back({glm::length(position[c] - u), c});
-    const std::size_t nearest = std::min<std::size_t>(kNearestNodes, by_distance.size());
-    std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(nearest),
-                      by_distance.end());
-    by_distance.resize(nearest);
-    for (std::uint32_t c : graph_adjacency[owner[k]])
-      by_distance.push_back({glm::length(position[c] - u), c});
-    std::sort(by_distance.begin(), by_distance.end());
-    bool moved = false;
-    for (const auto& [d, c] : by_distance)
-      if (surface.sees(k, position[c])) {
-        std::erase(members[owner[k]], k);
-        members[c].push_back(k);
-        owner[k] = c;
-        moved = true;
-        break;
-      }
-    if (!moved) {
+    if (choice[k] == owner[k]) continue;
+    if (choice[k] != UINT32_MAX) {
+      moved_in[choice[k]].push_back(k);
+      owner[k] = choice[k];
+    } else {
       ++failing;
-      // Sheets: the vertex leaves its curve node and becomes a sheet node (below). Curve nodes
-      // keep their positions, so no other vertex's visibility changes.
-      if (options.sheets && surface.sheet_point(k)) {
-        in_sheet[k] = 1;
-        std::erase(members[owner[k]], k);
-      }
+      in_sheet[k] = has_sheet_point[k];
     }
+  }
+  for (std::uint32_t c = 0; c < curve_nodes; ++c) {
+    std::erase_if(members[c], [&](std::uint32_t k) { return owner[k] != c || in_sheet[k]; });
+    members[c].insert(members[c].end(), moved_in[c].begin(), moved_in[c].end());
   }
   Skeleton sk;
   sk.curve_reliability = 1.0 - static_cast<double>(failing) / static_cast<double>(n);
@@ -378,7 +394,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   std::vector<std::uint32_t> node_of_vertex(n, UINT32_MAX);
   for (std::uint32_t k = 0; k < n; ++k)
     if (!in_sheet[k]) node_of_vertex[k] = node_of_curve[owner[k]];
-  add_sheet_nodes(surface, in_sheet, options.sheet_spacing * diag, sk.nodes, node_of_vertex);
+  add_sheet_nodes(surface, in_sheet, sheet_point, options.sheet_spacing * diag, sk.nodes, node_of_vertex);
   watch.lap("sheet nodes");
 
   std::set<std::array<std::uint32_t, 2>> edges;
@@ -439,11 +455,12 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   for (const auto& e : edges)
     if (!sheet_edges.count(e)) sk.edges.push_back(e);
 
-  std::size_t seen = 0;
-  for (std::uint32_t k = 0; k < n; ++k) {
-    const bool ok = surface.sees(k, sk.nodes[node_of_vertex[k]].position);
-    seen += ok;
-  }
+  std::vector<std::uint8_t> sees_node(n, 0);
+  detail::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k)
+      sees_node[k] = surface.sees(k, sk.nodes[node_of_vertex[k]].position);
+  });
+  const auto seen = static_cast<std::size_t>(std::count(sees_node.begin(), sees_node.end(), 1));
   sk.reliability = static_cast<double>(seen) / static_cast<double>(n);
   watch.lap("edges, sheets and reliability");
   if (sk.reliability < 1.0)
