@@ -52,7 +52,7 @@ struct ContractionOptions {
   // medial axis is 0.0088 against 0.0016 at 1e-4, and CGAL's camel stops after 2 iterations
   // (a step grew the area), so the default is 1e-4.
   double wl_scale = 1e-4;
-  double sl = 2.0;   // W_L is multiplied by sl after every iteration (Au: S_L = 2) ...
+  double sl = 3.0;   // W_L is multiplied by sl after every iteration (Au: S_L = 2) ...
   // ... or by sl^2 after an iteration that shrank the total area by less than this fraction
   // (0 = never): a stall while thin parts, held by the SDF weights, wait for W_L.
   double stall_ratio = 0.0;
@@ -74,7 +74,7 @@ struct ContractionOptions {
   // ... and every later iteration recomputes it on the current mesh with this many rays
   // (0 = sdf.rays): the centering term needs only an approximate thickness. See README.md for
   // the measurements behind the default.
-  int iteration_rays = 16;
+  int iteration_rays = 8;
   // extract(): a mesh with more vertices than this is contracted through a proxy simplified to
   // this many vertices (manifold-preserving quadric edge collapses that keep closedness and
   // genus); every input vertex follows the proxy vertex it was merged into, and the skeleton
