@@ -164,16 +164,22 @@ private:
     return q;
   }
 
-  // Sorted neighbours of v over its live faces.
-  std::vector<std::uint32_t> neighbours(std::uint32_t v) const {
-    std::vector<std::uint32_t> n;
+  // Sorted neighbours of v over its live faces, into n (reused storage).
+  void neighbours(std::uint32_t v, std::vector<std::uint32_t>& n) const {
+    n.clear();
     for (std::uint32_t f : vertex_faces_[v])
       if (face_alive_[f])
         for (std::uint32_t w : faces_[f])
           if (w != v) n.push_back(w);
     std::sort(n.begin(), n.end());
     n.erase(std::unique(n.begin(), n.end()), n.end());
-    return n;
+  }
+
+  // Live faces around v: its number of neighbours on a closed manifold.
+  std::size_t live_faces(std::uint32_t v) const {
+    std::size_t c = 0;
+    for (std::uint32_t f : vertex_faces_[v]) c += face_alive_[f];
+    return c;
   }
 
   void push(std::uint32_t a, std::uint32_t b) {
@@ -208,14 +214,21 @@ private:
     }
     if (shared != 2 || opposite[0] == opposite[1]) return false;
     // Link condition: the common neighbours are exactly the two opposite vertices.
-    const std::vector<std::uint32_t> na = neighbours(a), nb = neighbours(b);
-    std::vector<std::uint32_t> common;
-    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-    if (common.size() != 2) return false;
+    std::vector<std::uint32_t>& na = scratch_a_;
+    std::vector<std::uint32_t>& nb = scratch_b_;
+    neighbours(a, na);
+    neighbours(b, nb);
+    std::size_t common = 0;
+    for (auto i = na.begin(), j = nb.begin(); i != na.end() && j != nb.end();) {
+      if (*i < *j) ++i;
+      else if (*j < *i) ++j;
+      else ++common, ++i, ++j;
+    }
+    if (common != 2) return false;
     // Every vertex keeps at least three neighbours.
     if (na.size() + nb.size() < 7) return false;  // merged degree |na| + |nb| - 4 >= 3
     for (std::uint32_t o : opposite)
-      if (neighbours(o).size() < 4) return false;
+      if (live_faces(o) < 4) return false;  // o loses one neighbour
     // No face around the merged vertex turns over, degenerates or becomes a sliver.
     for (std::uint32_t v : {a, b})
       for (std::uint32_t f : vertex_faces_[v]) {
@@ -261,7 +274,8 @@ private:
     ++collapses;
     ++stamp_[a];
     ++stamp_[b];
-    for (std::uint32_t w : neighbours(a)) push(std::min(a, w), std::max(a, w));
+    neighbours(a, scratch_a_);
+    for (std::uint32_t w : scratch_a_) push(std::min(a, w), std::max(a, w));
   }
 
   std::vector<glm::dvec3> pos_;
@@ -273,6 +287,7 @@ private:
   std::vector<std::uint8_t> alive_;
   std::vector<std::uint32_t> parent_;
   std::size_t live_ = 0;
+  mutable std::vector<std::uint32_t> scratch_a_, scratch_b_;  // neighbour lists, reused
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> queue_;
 };
 
