@@ -9,7 +9,9 @@
 //
 // The SDF comes from any SdfBackend (a session: the GPU backends keep their context and
 // buffers). contract() calls backend->set_mesh(mesh) once, then update_positions() and
-// compute_sdf() at every iteration on the current, contracting mesh.
+// compute_sdf() at every iteration on the current, contracting mesh. extract() on a mesh above
+// ContractionOptions::proxy_vertices contracts a simplified proxy that way, then calls
+// set_mesh(input) once more for the input's own SDF.
 //
 // Input: a closed (watertight, edge-manifold) triangle mesh. A mesh with boundary edges or
 // non-manifold edges is refused with an InputError. A mesh of several components is contracted
