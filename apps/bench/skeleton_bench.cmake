@@ -32,4 +32,9 @@ target_link_libraries(sdfkit_skeleton_bench PRIVATE
   sdfkit::skeleton sdfkit::reference sdfkit::io CGAL::CGAL Eigen3::Eigen)
 target_compile_definitions(sdfkit_skeleton_bench PRIVATE
   CGAL_EIGEN3_ENABLED SDFKIT_SKELETON_BENCH_DATA="${SDFKIT_SKELETON_BENCH_DATA}")
+# The engine's own ray caster (OpenCL; PoCL on a CPU) is the default SDF backend when built.
+if(TARGET sdfkit_opencl)
+  target_link_libraries(sdfkit_skeleton_bench PRIVATE sdfkit::opencl)
+  target_compile_definitions(sdfkit_skeleton_bench PRIVATE SDFKIT_SKELETON_BENCH_OPENCL=1)
+endif()
 sdfkit_target_defaults(sdfkit_skeleton_bench)

@@ -38,6 +38,7 @@ void add_skeleton_command(CLI::App& app) {
     std::string input, output;
     bool no_sdf_term = false, no_sheets = false, quiet = false;
     int iterations = 20;
+    std::size_t proxy_vertices = skeleton::ContractionOptions{}.proxy_vertices;
     SdfCliOptions sdf;
   };
   auto a = std::make_shared<Args>();
@@ -49,6 +50,9 @@ void add_skeleton_command(CLI::App& app) {
   cmd->add_flag("--no-sdf-term", a->no_sdf_term, "Plain Au et al. contraction (no SDF centering or holding weights)");
   cmd->add_flag("--no-sheets", a->no_sheets, "Curves only, even where a curve is not reliable");
   cmd->add_option("--iterations", a->iterations, "Contraction iteration cap")->check(CLI::Range(1, 200));
+  cmd->add_option("--proxy-vertices", a->proxy_vertices,
+                  "Contract a simplified proxy of at most this many vertices when the mesh has more (0 = contract the mesh itself)")
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
   add_sdf_options(*cmd, a->sdf);
   add_output_options(*cmd, a->sdf, false);
@@ -65,6 +69,7 @@ void add_skeleton_command(CLI::App& app) {
     skeleton::ContractionOptions contraction;
     contraction.sdf_term = !a->no_sdf_term;
     contraction.max_iterations = a->iterations;
+    contraction.proxy_vertices = a->proxy_vertices;
     contraction.sdf = a->sdf.sdf;
     skeleton::SkeletonOptions options;
     options.sheets = !a->no_sheets;

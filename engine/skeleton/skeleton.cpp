@@ -5,6 +5,8 @@
 
 #include "bvh.hpp"
 #include "laplacian.hpp"
+#include "parallel.hpp"
+#include "simplify.hpp"
 #include "surgery.hpp"
 #include "validate.hpp"
 
@@ -52,17 +54,19 @@ struct Surface {
     // otherwise (no SDF, or a vertex on a sharp edge whose cone estimate points past a
     // concavity) an inside point the vertex sees (see seen_inside_point).
     centre.resize(o.positions.size());
-    for (std::uint32_t k = 0; k < o.positions.size(); ++k) {
-      const glm::vec3 u = o.positions[k];
-      if (!sdf.empty()) {
-        const glm::vec3 p = u - 0.5f * sdf[k] * normals[k];
-        if (!bvh.segment_blocked(u, p, k) && bvh.inside(p)) {
-          centre[k] = p;
-          continue;
+    detail::parallel_for(o.positions.size(), [&](std::size_t begin, std::size_t end) {
+      for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
+        const glm::vec3 u = o.positions[k];
+        if (!sdf.empty()) {
+          const glm::vec3 p = u - 0.5f * sdf[k] * normals[k];
+          if (!bvh.segment_blocked(u, p, k) && bvh.inside(p)) {
+            centre[k] = p;
+            continue;
+          }
         }
+        centre[k] = seen_inside_point(k, {u - normals[k], c.positions[k]}).value_or(c.positions[k]);
       }
-      centre[k] = seen_inside_point(k, {u - normals[k], c.positions[k]}).value_or(c.positions[k]);
-    }
+    });
   }
 
   bool sees(std::uint32_t k, const glm::vec3& p) const {
@@ -152,19 +156,17 @@ struct Surface {
   }
 };
 
-// Sheet nodes: the sheet vertices' sheet points (Surface::sheet_point) clustered on a grid of
+// Sheet nodes: the sheet vertices' sheet points (`point`, from Surface::sheet_point) clustered on a grid of
 // cell `spacing` (model units; 0 = one node per vertex). A cluster's node sits at the mean of
 // its sheet points (or, when that is outside the solid, at the member's point closest to it);
 // a member that cannot see it keeps a node of its own at its sheet point, so every sheet vertex
 // sees its node.
 void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in_sheet,
-                     double spacing, std::vector<Node>& nodes,
+                     const std::vector<glm::vec3>& point, double spacing, std::vector<Node>& nodes,
                      std::vector<std::uint32_t>& node_of_vertex) {
   std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> cells;
-  std::vector<glm::vec3> point(in_sheet.size());
   for (std::uint32_t k = 0; k < in_sheet.size(); ++k) {
     if (!in_sheet[k]) continue;
-    point[k] = *surface.sheet_point(k);  // in_sheet only holds vertices that have one
     std::array<std::int64_t, 3> key{static_cast<std::int64_t>(k), 0, 0};
     if (spacing > 0.0)
       for (int a = 0; a < 3; ++a) key[a] = static_cast<std::int64_t>(std::floor(point[k][a] / spacing));
@@ -227,18 +229,45 @@ void validate(const SkeletonOptions& o) {
     throw InputError("skeleton collapse cost weights must be >= 0 and not both 0");
 }
 
-}  // namespace
+// A contracted proxy of the input (extract() with ContractionOptions::proxy_vertices): the
+// surgery runs on it, and its nodes' members are expanded to the input vertices merged into
+// each proxy vertex.
+struct ContractedProxy {
+  const Mesh& contracted;                       // the contracted proxy
+  const std::vector<std::uint32_t>& vertex_map;  // per input vertex: its proxy vertex
+};
 
-Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
-                        const SkeletonOptions& options) {
-  validate(options);
-  detail::require_closed(original, "skeleton extraction");
+// Connectivity surgery on the contracted input, or on the contracted proxy with per proxy
+// vertex the mean local radius and centre point of its input vertices; node members are input
+// vertices either way.
+detail::CurveGraph surgery(const Surface& surface, const std::vector<float>& local_radius,
+                           const ContractedProxy* proxy, const detail::SurgeryOptions& so) {
+  if (proxy == nullptr) return detail::collapse_to_curves(surface.contracted, local_radius, surface.centre, so);
+  const std::size_t m = proxy->contracted.positions.size();
+  std::vector<std::vector<std::uint32_t>> inputs(m);
+  for (std::uint32_t k = 0; k < proxy->vertex_map.size(); ++k) inputs[proxy->vertex_map[k]].push_back(k);
+  std::vector<float> radius(m, 0.0f);
+  std::vector<glm::vec3> centre(m);
+  for (std::uint32_t p = 0; p < m; ++p) {
+    double r = 0.0;
+    glm::dvec3 c(0.0);
+    for (std::uint32_t k : inputs[p]) r += local_radius[k], c += glm::dvec3(surface.centre[k]);
+    const double count = std::max<double>(1.0, static_cast<double>(inputs[p].size()));
+    radius[p] = static_cast<float>(r / count);
+    centre[p] = inputs[p].empty() ? proxy->contracted.positions[p] : glm::vec3(c / count);
+  }
+  detail::CurveGraph graph = detail::collapse_to_curves(proxy->contracted, radius, centre, so);
+  for (std::vector<std::uint32_t>& members : graph.members) {
+    std::vector<std::uint32_t> expanded;
+    for (std::uint32_t p : members) expanded.insert(expanded.end(), inputs[p].begin(), inputs[p].end());
+    members = std::move(expanded);
+  }
+  return graph;
+}
+
+Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+               const SkeletonOptions& options, const ContractedProxy* proxy) {
   const std::size_t n = original.positions.size();
-  if (contracted.positions.size() != n || contracted.triangles != original.triangles)
-    throw InputError("the contracted mesh does not match the original's connectivity");
-  if (!sdf.empty() && sdf.size() != n)
-    throw InputError("the SDF has " + std::to_string(sdf.size()) + " values for " +
-                     std::to_string(n) + " vertices");
 
   const double diag = bounding_box(original.positions).diagonal();
   std::vector<float> local_radius(n);
@@ -253,8 +282,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   Stopwatch watch;
   const Surface surface(original, contracted, sdf);
   watch.lap("BVH and centre points");
-  const detail::CurveGraph graph =
-      detail::collapse_to_curves(contracted, local_radius, surface.centre, so);
+  const detail::CurveGraph graph = surgery(surface, local_radius, proxy, so);
   watch.lap("connectivity surgery");
 
   const std::size_t curve_nodes = graph.positions.size();
@@ -275,39 +303,54 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
     graph_adjacency[e[0]].push_back(e[1]);
     graph_adjacency[e[1]].push_back(e[0]);
   }
+  // Per vertex, independently (node positions are fixed here): the node it ends with, or
+  // UINT32_MAX when it sees none (then, with sheets on, its sheet point if it has one).
+  std::vector<std::uint32_t> choice(n);
+  std::vector<std::uint8_t> has_sheet_point(n, 0);
+  std::vector<glm::vec3> sheet_point(n);
+  detail::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
+      choice[k] = owner[k];
+      if (surface.sees(k, position[owner[k]])) continue;
+      const glm::vec3 u = original.positions[k];
+      std::vector<std::pair<float, std::uint32_t>> by_distance;
+      for (std::uint32_t c = 0; c < curve_nodes; ++c)
+        if (c != owner[k]) by_distance.push_back({glm::length(position[c] - u), c});
+      const std::size_t nearest = std::min<std::size_t>(kNearestNodes, by_distance.size());
+      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(nearest),
+                        by_distance.end());
+      by_distance.resize(nearest);
+      for (std::uint32_t c : graph_adjacency[owner[k]])
+        by_distance.push_back({glm::length(position[c] - u), c});
+      std::sort(by_distance.begin(), by_distance.end());
+      choice[k] = UINT32_MAX;
+      for (const auto& [d, c] : by_distance)
+        if (surface.sees(k, position[c])) {
+          choice[k] = c;
+          break;
+        }
+      if (choice[k] == UINT32_MAX && options.sheets)
+        if (const auto p = surface.sheet_point(k)) has_sheet_point[k] = 1, sheet_point[k] = *p;
+    }
+  });
+  // Apply in vertex order: a vertex moves to its chosen node; one that sees none stays
+  // (failing) or, with sheets, leaves its curve node and becomes a sheet vertex (below).
   std::vector<std::uint8_t> in_sheet(n, 0);
   std::size_t failing = 0;
+  std::vector<std::vector<std::uint32_t>> moved_in(curve_nodes);
   for (std::uint32_t k = 0; k < n; ++k) {
-    if (surface.sees(k, position[owner[k]])) continue;
-    const glm::vec3 u = original.positions[k];
-    std::vector<std::pair<float, std::uint32_t>> by_distance;
-    for (std::uint32_t c = 0; c < curve_nodes; ++c)
-      if (c != owner[k]) by_distance.push_back({glm::length(position[c] - u), c});
-    const std::size_t nearest = std::min<std::size_t>(kNearestNodes, by_distance.size());
-    std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(nearest),
-                      by_distance.end());
-    by_distance.resize(nearest);
-    for (std::uint32_t c : graph_adjacency[owner[k]])
-      by_distance.push_back({glm::length(position[c] - u), c});
-    std::sort(by_distance.begin(), by_distance.end());
-    bool moved = false;
-    for (const auto& [d, c] : by_distance)
-      if (surface.sees(k, position[c])) {
-        std::erase(members[owner[k]], k);
-        members[c].push_back(k);
-        owner[k] = c;
-        moved = true;
-        break;
-      }
-    if (!moved) {
+    if (choice[k] == owner[k]) continue;
+    if (choice[k] != UINT32_MAX) {
+      moved_in[choice[k]].push_back(k);
+      owner[k] = choice[k];
+    } else {
       ++failing;
-      // Sheets: the vertex leaves its curve node and becomes a sheet node (below). Curve nodes
-      // keep their positions, so no other vertex's visibility changes.
-      if (options.sheets && surface.sheet_point(k)) {
-        in_sheet[k] = 1;
-        std::erase(members[owner[k]], k);
-      }
+      in_sheet[k] = has_sheet_point[k];
     }
+  }
+  for (std::uint32_t c = 0; c < curve_nodes; ++c) {
+    std::erase_if(members[c], [&](std::uint32_t k) { return owner[k] != c || in_sheet[k]; });
+    members[c].insert(members[c].end(), moved_in[c].begin(), moved_in[c].end());
   }
   Skeleton sk;
   sk.curve_reliability = 1.0 - static_cast<double>(failing) / static_cast<double>(n);
@@ -351,7 +394,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   std::vector<std::uint32_t> node_of_vertex(n, UINT32_MAX);
   for (std::uint32_t k = 0; k < n; ++k)
     if (!in_sheet[k]) node_of_vertex[k] = node_of_curve[owner[k]];
-  add_sheet_nodes(surface, in_sheet, options.sheet_spacing * diag, sk.nodes, node_of_vertex);
+  add_sheet_nodes(surface, in_sheet, sheet_point, options.sheet_spacing * diag, sk.nodes, node_of_vertex);
   watch.lap("sheet nodes");
 
   std::set<std::array<std::uint32_t, 2>> edges;
@@ -412,11 +455,12 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   for (const auto& e : edges)
     if (!sheet_edges.count(e)) sk.edges.push_back(e);
 
-  std::size_t seen = 0;
-  for (std::uint32_t k = 0; k < n; ++k) {
-    const bool ok = surface.sees(k, sk.nodes[node_of_vertex[k]].position);
-    seen += ok;
-  }
+  std::vector<std::uint8_t> sees_node(n, 0);
+  detail::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k)
+      sees_node[k] = surface.sees(k, sk.nodes[node_of_vertex[k]].position);
+  });
+  const auto seen = static_cast<std::size_t>(std::count(sees_node.begin(), sees_node.end(), 1));
   sk.reliability = static_cast<double>(seen) / static_cast<double>(n);
   watch.lap("edges, sheets and reliability");
   if (sk.reliability < 1.0)
@@ -426,20 +470,82 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   return sk;
 }
 
+}  // namespace
+
+Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+                        const SkeletonOptions& options) {
+  validate(options);
+  detail::require_closed(original, "skeleton extraction");
+  const std::size_t n = original.positions.size();
+  if (contracted.positions.size() != n || contracted.triangles != original.triangles)
+    throw InputError("the contracted mesh does not match the original's connectivity");
+  if (!sdf.empty() && sdf.size() != n)
+    throw InputError("the SDF has " + std::to_string(sdf.size()) + " values for " +
+                     std::to_string(n) + " vertices");
+  return build(original, contracted, sdf, options, nullptr);
+}
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+}  // namespace
+
 Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
                  const SkeletonOptions& options) {
   validate(options);
-  ContractionResult c = contract(mesh, backend, contraction);
-  std::vector<float> sdf = std::move(c.first_sdf);
+  detail::require_closed(mesh, "skeleton extraction");
+  using Clock = std::chrono::steady_clock;
+  Skeleton::Timings seconds;
+  SdfOptions so = contraction.sdf;
+  so.domain = SdfDomain::Vertex;
+  const std::size_t limit = contraction.proxy_vertices;
+  const bool use_proxy = limit > 0 && mesh.positions.size() > limit;
+
+  // The proxy path: contract a simplified copy, carry every input vertex along with the proxy
+  // vertex it was merged into, and build the skeleton for the input.
+  auto t = Clock::now();
+  detail::Simplified proxy;
+  if (use_proxy) {
+    proxy = detail::simplify(mesh, limit);
+    seconds.simplify = seconds_since(t);
+    log_debug("skeleton: proxy of " + std::to_string(proxy.mesh.positions.size()) + " vertices (" +
+              std::to_string(proxy.collapses) + " collapses, " + std::to_string(proxy.refused) +
+              " refused) in " + std::to_string(1e3 * seconds.simplify) + " ms");
+  }
+  t = Clock::now();
+  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, contraction);
+  seconds.contraction = seconds_since(t);
+  seconds.contraction_sdf = c.sdf_seconds;
+  seconds.contraction_solve = c.solve_seconds;
+
+  // The input's own SDF at full quality (radii, centre points, grouping, Skeleton::sdf): the
+  // first SDF of the contraction, else measured once here.
+  t = Clock::now();
+  std::vector<float> sdf;
+  if (!use_proxy) sdf = std::move(c.first_sdf);
   if (backend != nullptr && sdf.empty()) {
-    SdfOptions so = contraction.sdf;
-    so.domain = SdfDomain::Vertex;
     backend->set_mesh(mesh);
     sdf = compute_sdf(*backend, mesh, so).values;
+    seconds.input_sdf = seconds_since(t);
   }
-  Skeleton sk = build_skeleton(mesh, c.contracted, sdf, options);
+
+  t = Clock::now();
+  Skeleton sk;
+  if (use_proxy) {
+    Mesh contracted{.positions = std::vector<glm::vec3>(mesh.positions.size()), .triangles = mesh.triangles};
+    for (std::size_t k = 0; k < mesh.positions.size(); ++k)
+      contracted.positions[k] = c.contracted.positions[proxy.vertex_map[k]];
+    const ContractedProxy contracted_proxy{c.contracted, proxy.vertex_map};
+    sk = build(mesh, contracted, sdf, options, &contracted_proxy);
+  } else {
+    sk = build(mesh, c.contracted, sdf, options, nullptr);
+  }
+  seconds.build = seconds_since(t);
   sk.iterations = c.iterations;
+  sk.contracted_vertices = use_proxy ? proxy.mesh.positions.size() : mesh.positions.size();
   sk.sdf = std::move(sdf);
+  sk.seconds = seconds;
   sk.warnings.insert(sk.warnings.begin(), c.warnings.begin(), c.warnings.end());
   return sk;
 }

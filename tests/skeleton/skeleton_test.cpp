@@ -162,11 +162,34 @@ TEST(Skeleton, StarGivesFiveBranchesFromOneJunction) {
 
 TEST(Skeleton, SdfTermBringsNodesCloserToTheMedialAxis) {
   const auto star = models::five_armed_star();
+  ASSERT_GT(star.mesh.positions.size(), sk::ContractionOptions{}.proxy_vertices);  // the proxy path
   const double with = mean_distance(run(star.mesh, true, false), star.axis);
   const double without = mean_distance(run(star.mesh, false, false), star.axis);
   std::printf("star: mean node distance to the medial axis: with SDF term %.4f, without %.4f\n",
               with, without);
   EXPECT_LT(with, without);
+}
+
+TEST(SkeletonContraction, SdfTermContractsTheStarCloserToItsMedialAxis) {
+  // The contracted surface itself, over all 3888 vertices (the node comparison above is decided
+  // by the one or two of its ~8 nodes nearest the junction).
+  const auto star = models::five_armed_star();
+  double mean[2], median[2];
+  for (int term = 0; term < 2; ++term) {
+    reference::EmbreeBackend backend;
+    sk::ContractionOptions co;
+    co.sdf_term = term == 1;
+    const sk::ContractionResult r = sk::contract(star.mesh, &backend, co);
+    std::vector<double> d;
+    for (const glm::vec3& p : r.contracted.positions) d.push_back(models::distance_to(star.axis, p));
+    mean[term] = std::accumulate(d.begin(), d.end(), 0.0) / static_cast<double>(d.size());
+    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+    median[term] = d[d.size() / 2];
+  }
+  std::printf("star: contracted vertices' distance to the medial axis: with SDF term mean %.4f median "
+              "%.4f, without mean %.4f median %.4f\n", mean[1], median[1], mean[0], median[0]);
+  EXPECT_LT(mean[1], 0.8 * mean[0]);
+  EXPECT_LT(median[1], 0.8 * median[0]);
 }
 
 TEST(Skeleton, SheetsMakeTheCAndSShapesFullyReliable) {
@@ -293,4 +316,80 @@ TEST(Skeleton, RealMeshesGiveAValidSkeletonOrAClearError) {
       EXPECT_GT(std::string(e.what()).size(), 20u);
     }
   }
+}
+
+namespace {
+// Records the ray count of every SDF the contraction asks for.
+class RayCountingBackend final : public SdfBackend {
+public:
+  std::string name() const override { return "ray-counting"; }
+  std::string device_name() const override { return inner.device_name(); }
+  void set_mesh(const Mesh& m) override { vertices.push_back(m.positions.size()), inner.set_mesh(m); }
+  void update_positions(std::span<const glm::vec3> p) override { inner.update_positions(p); }
+  RawSdf compute(const SdfQuery& q, const SdfOptions& o) override {
+    rays.push_back(o.rays);
+    return inner.compute(q, o);
+  }
+  reference::EmbreeBackend inner;
+  std::vector<int> rays;
+  std::vector<std::size_t> vertices;  // per set_mesh call: the mesh's vertex count
+};
+}  // namespace
+
+TEST(SkeletonContraction, FirstSdfAtFullQualityLaterOnesWithIterationRays) {
+  const Mesh mesh = shapes::capsule(0.5f, 3.0f, 16, 12);
+  RayCountingBackend backend;
+  sk::ContractionOptions o;
+  o.sdf.rays = 24;
+  o.iteration_rays = 6;
+  const sk::ContractionResult r = sk::contract(mesh, &backend, o);
+  ASSERT_GE(backend.rays.size(), 3u);
+  EXPECT_EQ(backend.rays.front(), 24);
+  for (std::size_t i = 1; i < backend.rays.size(); ++i) EXPECT_EQ(backend.rays[i], 6);
+  EXPECT_GT(r.sdf_seconds, 0.0);
+  EXPECT_GT(r.solve_seconds, 0.0);
+  o.iteration_rays = 0;  // 0 = sdf.rays throughout
+  backend.rays.clear();
+  sk::contract(mesh, &backend, o);
+  for (int n : backend.rays) EXPECT_EQ(n, 24);
+}
+
+TEST(Skeleton, FineCapsuleGoesThroughTheProxyAndKeepsItsProperties) {
+  // 4k vertices, above the proxy threshold: the contraction runs on a ~1k-vertex proxy, the
+  // skeleton is still the input's (every input vertex in one node, nodes inside the input,
+  // radii and Skeleton::sdf from the input's SDF).
+  const float radius = 0.5f, length = 4.0f;
+  const Mesh mesh = shapes::capsule(radius, length, 64, 64);
+  RayCountingBackend backend;
+  sk::ContractionOptions co;
+  co.proxy_vertices = 1000;
+  ASSERT_GT(mesh.positions.size(), 4 * co.proxy_vertices);
+  const sk::Skeleton s = sk::extract(mesh, &backend, co, {});
+  EXPECT_LE(s.contracted_vertices, co.proxy_vertices);
+  EXPECT_GT(s.contracted_vertices, co.proxy_vertices / 2);
+  // The proxy is contracted, then the input's SDF is measured once.
+  ASSERT_EQ(backend.vertices.size(), 2u);
+  EXPECT_EQ(backend.vertices[0], s.contracted_vertices);
+  EXPECT_EQ(backend.vertices[1], mesh.positions.size());
+  EXPECT_EQ(backend.rays.back(), co.sdf.rays);
+  ASSERT_EQ(s.sdf.size(), mesh.positions.size());
+  std::vector<float> sdf = s.sdf;
+  std::nth_element(sdf.begin(), sdf.begin() + sdf.size() / 2, sdf.end());
+  EXPECT_NEAR(sdf[sdf.size() / 2], 2.0f * radius, 0.15f);
+
+  expect_partition_and_inside(mesh, s);
+  ASSERT_GE(s.nodes.size(), 2u);
+  EXPECT_EQ(s.edges.size(), s.nodes.size() - 1);
+  EXPECT_EQ(sk::cycle_count(s), 0);
+  EXPECT_EQ(parts(s), 1);
+  EXPECT_EQ(count_degree(s, 1), 2);
+  EXPECT_EQ(count_degree(s, 2), static_cast<int>(s.nodes.size()) - 2);
+  EXPECT_TRUE(s.sheet_triangles.empty());
+  const float total = length + 2.0f * radius;
+  for (const sk::Node& n : s.nodes) {
+    EXPECT_LT(std::hypot(n.position.x, n.position.y), 0.02f * total);
+    EXPECT_NEAR(n.radius, radius, 0.35f * radius);
+  }
+  EXPECT_DOUBLE_EQ(s.reliability, 1.0);
+  EXPECT_DOUBLE_EQ(s.curve_reliability, 1.0);
 }
