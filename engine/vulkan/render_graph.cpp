@@ -661,7 +661,7 @@ const char* layout_name(VkImageLayout l) {
 std::string CompiledGraph::describe() const {
   std::ostringstream o;
   auto barrier_line = [&](const Barrier& b) {
-    o << "    barrier " << b.resource << ": " << stage_names(b.src.stages) << " (" << access_names(b.src.access)
+    o << "    barrier before: " << b.resource << ": " << stage_names(b.src.stages) << " (" << access_names(b.src.access)
       << ") -> " << stage_names(b.dst.stages) << " (" << access_names(b.dst.access) << ")";
     if (b.image && b.src.layout != b.dst.layout)
       o << ", layout " << layout_name(b.src.layout) << " -> " << layout_name(b.dst.layout);
@@ -670,7 +670,6 @@ std::string CompiledGraph::describe() const {
   o << "passes (" << passes.size() << "):\n";
   for (std::size_t i = 0; i < passes.size(); ++i) {
     const CompiledPass& p = passes[i];
-    for (const Barrier& b : p.barriers) barrier_line(b);
     o << "  " << i << ". " << p.name << " ["
       << (p.kind == PassKind::Graphics ? "graphics" : p.kind == PassKind::Compute ? "compute" : "transfer") << "]:";
     for (const PassUse& u : p.uses) {
@@ -679,6 +678,8 @@ std::string CompiledGraph::describe() const {
       o << ";";
     }
     o << "\n";
+    // Recorded before the pass; listed under it.
+    for (const Barrier& b : p.barriers) barrier_line(b);
   }
   if (!final_barriers.empty()) o << "  end:\n";
   for (const Barrier& b : final_barriers) barrier_line(b);
