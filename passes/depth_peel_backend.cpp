@@ -18,6 +18,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <exception>
+#include <future>
 #include <map>
 #include <span>
 #include <string_view>
@@ -260,6 +262,10 @@ struct DepthPeelBackend::Impl {
   std::size_t node_capacity = 0;
   std::size_t dropped = 0;
   std::size_t submitted = 0;  // triangles drawn by the last run_lists, over all cameras
+  // FragmentLists: the cameras [camera_begin, camera_end) this context renders (camera_end 0 =
+  // all); with two lanes each context renders half (see DepthPeelConfig::lanes).
+  int camera_begin = 0, camera_end = 0;
+  Buffer staged_counts, staged_samples;  // host copies of counts/samples (lanes merge there)
 
   std::vector<StageTiming> timings;
   int last_layers = 0;
@@ -267,6 +273,14 @@ struct DepthPeelBackend::Impl {
   explicit Impl(const DepthPeelConfig& c);
   void upload_geometry(std::span<const glm::vec3> positions);
   void ensure_query_buffers(std::size_t n, std::uint32_t max_samples);
+  // Writes the query's points (origin moved inward, inward normal) into `points`.
+  void upload_points(const SdfQuery& query);
+  // Copies counts and samples of the first n points into staged_counts / staged_samples.
+  void stage_samples(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>& gpu);
+  // Appends the second lane's staged samples of each point after this lane's (in the staged
+  // copies); a point's count becomes the sum (it may exceed max_samples: the gather keeps the
+  // first max_samples and the overflow is reported as with one lane).
+  void append_lane_samples(const Impl& second, std::size_t n, std::uint32_t max_samples);
   void write_sets();
   void create_list_resources();
   void grow_nodes(std::size_t capacity);
@@ -452,7 +466,9 @@ void DepthPeelBackend::Impl::ensure_query_buffers(std::size_t n, std::uint32_t m
   bool changed = false;
   if (point_capacity < cap) {
     points = create_buffer(*ctx, 2 * cap * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Upload);
-    counts = create_buffer(*ctx, cap * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+    counts = create_buffer(*ctx, cap * 4,
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                            MemoryUse::DeviceLocal);
     result = create_buffer(*ctx, cap * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUse::Readback);
     point_capacity = cap;
@@ -465,7 +481,9 @@ void DepthPeelBackend::Impl::ensure_query_buffers(std::size_t n, std::uint32_t m
       throw DeviceError("the per-point sample storage (" + std::to_string(bytes >> 20) +
                         " MiB) exceeds the device's storage buffer range; use fewer views or a smaller "
                         "max_samples_per_point");
-    samples = create_buffer(*ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+    samples = create_buffer(*ctx, bytes,
+                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                             MemoryUse::DeviceLocal);
     sample_capacity = sc;
     changed = true;
@@ -533,8 +551,9 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
   const Pipeline& raster = front_layers ? list_all : list_back;
   dropped = 0;
   submitted = 0;
-  for (int base = 0; base < cfg.views;) {
-    const auto count = static_cast<std::uint32_t>(std::min(batch, cfg.views - base));
+  const int first_camera = camera_begin, end_camera = camera_end > 0 ? camera_end : cfg.views;
+  for (int base = first_camera; base < end_camera;) {
+    const auto count = static_cast<std::uint32_t>(std::min(batch, end_camera - base));
     RenderGraph g;
     auto cnt = g.import_buffer("counts", counts.size, {counts.get()});
     auto smp = g.import_buffer("samples", samples.size, {samples.get()});
@@ -542,7 +561,7 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
     auto hd = g.import_buffer("list_heads", heads.size, {heads.get()});
     auto nd = g.import_buffer("list_nodes", nodes.size, {nodes.get()});
     auto ctr = g.import_buffer("list_counter", counter.size, {counter.get()});
-    if (base == 0) {
+    if (base == first_camera) {
       auto clear = g.add_pass("clear_counts", PassKind::Transfer);
       cnt = clear.transfer_dst(cnt);
       clear.execute([&, cnt](PassContext& pc) { vkCmdFillBuffer(pc.cmd, pc.buffer(cnt), 0, VK_WHOLE_SIZE, 0); });
@@ -611,7 +630,7 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
       vkCmdDispatch(pc.cmd, groups, 1, 1);
     });
     const CompiledGraph plan = g.compile();
-    if (base == 0 && log_level() <= LogLevel::Debug)
+    if (base == first_camera && log_level() <= LogLevel::Debug)
       log_debug("fragment-list render graph (first batch):\n" + plan.describe());
     auto t = execute(*ctx, plan, transients, {.profile = cfg.profile});
     gpu.insert(gpu.end(), t.begin(), t.end());
@@ -626,10 +645,45 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
     }
     base += static_cast<int>(count);
   }
-  if (dropped > 0)
-    log_warning("the fragment-list node buffer overflowed (" + std::to_string(dropped) +
-                " fragments dropped); it was grown to " + std::to_string(node_capacity) +
-                " nodes and the affected camera batches were run again");
+}
+
+void DepthPeelBackend::Impl::upload_points(const SdfQuery& query) {
+  const std::size_t n = query.size();
+  auto* p = static_cast<glm::vec4*>(points.mapped());
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 nrm = query.normals[i];
+    const bool valid = query.valid.empty() || query.valid[i];
+    p[i] = glm::vec4(query.origins[i] - query.origin_offset * nrm, valid ? 1.0f : 0.0f);
+    p[n + i] = glm::vec4(-nrm, 0.0f);
+  }
+}
+
+void DepthPeelBackend::Impl::stage_samples(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>& gpu) {
+  const VkDeviceSize count_bytes = 4 * static_cast<VkDeviceSize>(n);
+  const VkDeviceSize sample_bytes = static_cast<VkDeviceSize>(n) * max_samples * sizeof(glm::vec2);
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  if (!staged_counts.buffer || staged_counts.size < count_bytes)
+    staged_counts = create_buffer(*ctx, count_bytes, usage, MemoryUse::Readback);
+  if (!staged_samples.buffer || staged_samples.size < sample_bytes)
+    staged_samples = create_buffer(*ctx, sample_bytes, usage, MemoryUse::Readback);
+  RenderGraph g;
+  auto cnt = g.import_buffer("counts", counts.size, {counts.get()});
+  auto smp = g.import_buffer("samples", samples.size, {samples.get()});
+  auto sc = g.import_buffer("staged_counts", staged_counts.size, {staged_counts.get()});
+  auto ss = g.import_buffer("staged_samples", staged_samples.size, {staged_samples.get()});
+  auto copy = g.add_pass("stage_samples", PassKind::Transfer);
+  copy.transfer_src(cnt);
+  copy.transfer_src(smp);
+  sc = copy.transfer_dst(sc);
+  ss = copy.transfer_dst(ss);
+  copy.side_effect();  // read by the host
+  copy.execute([&, cnt, smp, sc, ss](PassContext& pc) {
+    const VkBufferCopy c1{0, 0, count_bytes}, c2{0, 0, sample_bytes};
+    vkCmdCopyBuffer(pc.cmd, pc.buffer(cnt), pc.buffer(sc), 1, &c1);
+    vkCmdCopyBuffer(pc.cmd, pc.buffer(smp), pc.buffer(ss), 1, &c2);
+  });
+  auto t = execute(*ctx, g.compile(), transients, {.profile = cfg.profile});
+  gpu.insert(gpu.end(), t.begin(), t.end());
 }
 
 RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_samples, std::vector<PassTiming>* gpu,
@@ -678,7 +732,39 @@ RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_sampl
   return out;
 }
 
-DepthPeelBackend::DepthPeelBackend(const DepthPeelConfig& config) : impl_(std::make_unique<Impl>(config)) {}
+void DepthPeelBackend::Impl::append_lane_samples(const Impl& second, std::size_t n, std::uint32_t max_samples) {
+  auto* have_counts = static_cast<std::uint32_t*>(staged_counts.mapped());
+  auto* have_samples = static_cast<glm::vec2*>(staged_samples.mapped());
+  const auto* more_counts = static_cast<const std::uint32_t*>(second.staged_counts.mapped());
+  const auto* more_samples = static_cast<const glm::vec2*>(second.staged_samples.mapped());
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t have = std::min(have_counts[i], max_samples);
+    const std::uint32_t add = std::min(more_counts[i], max_samples - have);
+    const std::size_t base = i * max_samples;
+    std::copy_n(more_samples + base, add, have_samples + base + have);
+    have_counts[i] += more_counts[i];
+  }
+}
+
+namespace {
+
+int resolve_lanes(const DepthPeelConfig& config, const Context& ctx) {
+  if (config.mode != PeelMode::FragmentLists) return 1;
+  if (config.lanes > 0) return std::min(config.lanes, 2);
+  return ctx.info().type == "cpu" && config.views >= 16 ? 2 : 1;
+}
+
+}  // namespace
+
+DepthPeelBackend::DepthPeelBackend(const DepthPeelConfig& config) : impl_(std::make_unique<Impl>(config)) {
+  if (resolve_lanes(config, *impl_->ctx) == 2) {
+    lane_ = std::make_unique<Impl>(config);
+    const int half = config.views / 2;
+    impl_->camera_end = half;
+    lane_->camera_begin = half;
+    lane_->camera_end = config.views;
+  }
+}
 DepthPeelBackend::~DepthPeelBackend() = default;
 
 std::string DepthPeelBackend::device_name() const { return impl_->ctx->info().name; }
@@ -686,12 +772,18 @@ Context& DepthPeelBackend::context() { return *impl_->ctx; }
 const DepthPeelConfig& DepthPeelBackend::config() const { return impl_->cfg; }
 int DepthPeelBackend::last_layer_count() const { return impl_->last_layers; }
 std::size_t DepthPeelBackend::fragment_capacity() const { return impl_->node_capacity; }
-std::size_t DepthPeelBackend::last_dropped_fragments() const { return impl_->dropped; }
-std::size_t DepthPeelBackend::last_submitted_triangles() const { return impl_->submitted; }
+std::size_t DepthPeelBackend::last_dropped_fragments() const {
+  return impl_->dropped + (lane_ ? lane_->dropped : 0);
+}
+std::size_t DepthPeelBackend::last_submitted_triangles() const {
+  return impl_->submitted + (lane_ ? lane_->submitted : 0);
+}
+int DepthPeelBackend::lanes() const { return lane_ ? 2 : 1; }
 bool DepthPeelBackend::peels_front_layers() const { return impl_->front_layers; }
 std::vector<StageTiming> DepthPeelBackend::last_timings() const { return impl_->timings; }
 std::size_t DepthPeelBackend::device_memory_bytes() const {
-  return static_cast<std::size_t>(impl_->ctx->allocator().peak_bytes_in_use());
+  return static_cast<std::size_t>(impl_->ctx->allocator().peak_bytes_in_use()) +
+         (lane_ ? static_cast<std::size_t>(lane_->ctx->allocator().peak_bytes_in_use()) : 0);
 }
 
 void DepthPeelBackend::set_mesh(const Mesh& mesh) {
@@ -704,6 +796,13 @@ void DepthPeelBackend::set_mesh(const Mesh& mesh) {
                       report.non_manifold_edges > 0;
   impl_->upload_geometry(mesh.positions);
   impl_->write_sets();
+  if (lane_) {
+    lane_->triangles = impl_->triangles;
+    lane_->vertex_count = impl_->vertex_count;
+    lane_->front_layers = impl_->front_layers;
+    lane_->upload_geometry(mesh.positions);
+    lane_->write_sets();
+  }
   impl_->timings = {{"upload_mesh", ms_since(t0)}};
 }
 
@@ -714,6 +813,7 @@ void DepthPeelBackend::update_positions(std::span<const glm::vec3> positions) {
                 std::to_string(impl_->vertex_count) + " vertices");
   const auto t0 = Clock::now();
   impl_->upload_geometry(positions);
+  if (lane_) lane_->upload_geometry(positions);
   impl_->timings = {{"upload_mesh", ms_since(t0)}};
 }
 
@@ -756,6 +856,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   // Keep the geometry upload of the preceding set_mesh/update_positions, replace the rest.
   std::erase_if(m.timings, [](const StageTiming& t) { return t.stage != "upload_mesh"; });
   m.ctx->allocator().reset_peak();
+  if (lane_) lane_->ctx->allocator().reset_peak();
   const std::size_t n = query.size();
   if (n == 0) return {};
 
@@ -776,14 +877,11 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
                       "smaller max_samples_per_point");
   if (n > limit) return compute_in_chunks(query, options, limit);
   m.ensure_query_buffers(n, max_samples);
-  {
-    auto* p = static_cast<glm::vec4*>(m.points.mapped());
-    for (std::size_t i = 0; i < n; ++i) {
-      const glm::vec3 nrm = query.normals[i];
-      const bool valid = query.valid.empty() || query.valid[i];
-      p[i] = glm::vec4(query.origins[i] - query.origin_offset * nrm, valid ? 1.0f : 0.0f);
-      p[n + i] = glm::vec4(-nrm, 0.0f);
-    }
+  m.upload_points(query);
+  Impl* lane = m.lists ? lane_.get() : nullptr;
+  if (lane) {
+    lane->ensure_query_buffers(n, max_samples);
+    lane->upload_points(query);
   }
   m.timings.push_back({"upload", ms_since(t0)});
 
@@ -799,9 +897,41 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   bool cap_hit = false;
   m.last_layers = 0;
   int previous_camera_layers = 1;
-  if (m.lists) {
+  if (m.lists && lane) {
+    // Two lanes: each context renders its half of the cameras on its own thread (lavapipe bins
+    // on one thread per queue, so the second context's binning overlaps the first one's
+    // rasterization), then the second lane's samples are appended to the first lane's per point.
+    std::vector<PassTiming> lane_gpu;
+    auto other = std::async(std::launch::async, [&] {
+      lane->run_lists(n, max_samples, cos_half, options.false_hit, lane_gpu);
+      lane->stage_samples(n, max_samples, lane_gpu);
+    });
+    std::exception_ptr failure;
+    try {
+      m.run_lists(n, max_samples, cos_half, options.false_hit, gpu);
+      m.stage_samples(n, max_samples, gpu);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    other.get();  // rethrows the lane's failure
+    if (failure) std::rethrow_exception(failure);
+    gpu.insert(gpu.end(), lane_gpu.begin(), lane_gpu.end());
+    for (const std::string& message : lane->ctx->validation_messages())
+      m.ctx->report_validation_message(VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT, ("(second lane) " + message).c_str());
+    lane->ctx->clear_validation_messages();
+    m.append_lane_samples(*lane, n, max_samples);
+    m.last_layers = 1;
+  } else if (m.lists) {
     m.run_lists(n, max_samples, cos_half, options.false_hit, gpu);
     m.last_layers = 1;
+  }
+  if (m.lists) {
+    const std::size_t dropped = m.dropped + (lane ? lane->dropped : 0);
+    const std::size_t capacity = std::max(m.node_capacity, lane ? lane->node_capacity : 0);
+    if (dropped > 0)
+      log_warning("the fragment-list node buffer overflowed (" + std::to_string(dropped) +
+                  " fragments dropped); it was grown to " + std::to_string(capacity) +
+                  " nodes and the affected camera batches were run again");
   }
 
   for (int base = 0; base < (m.lists ? 0 : m.cfg.views); base += m.batch) {
@@ -923,7 +1053,8 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   m.timings.push_back({m.lists ? "lists_and_resolve" : "peel_and_diameter", ms_since(t0)});
 
   t0 = Clock::now();
-  RawSdf out = m.run_gather(n, max_samples, &gpu);
+  RawSdf out = m.lists && lane ? m.run_gather(n, max_samples, &gpu, &m.staged_counts, &m.staged_samples)
+                               : m.run_gather(n, max_samples, &gpu);
   m.timings.push_back({"gather", ms_since(t0)});
 
   const auto* accepted = static_cast<const std::uint32_t*>(m.result.mapped());

@@ -102,6 +102,13 @@ struct DepthPeelConfig {
   // pipeline would cull triangle by triangle after vertex processing. 0 or 1 = one draw of all
   // triangles per camera. Same values either way.
   int normal_bins = 64;
+  // FragmentLists: contexts that render the cameras, each its half on its own thread (1 or 2;
+  // 0 = automatic: 2 on CPU devices with at least 16 views, else 1). On lavapipe one queue
+  // thread bins every triangle of a render pass before the rasterizer threads start on it, so
+  // a second context (device) binning the other half overlaps the first one's rasterization;
+  // the second lane's samples are appended to the first lane's per point before the gather.
+  // A GPU runs one context.
+  int lanes = 0;
 };
 
 // Devices as `sdfkit devices` shows them, with suitability for this backend.
@@ -136,6 +143,8 @@ public:
   // compute() (its last chunk of points when it ran in chunks). Without normal groups (or on an
   // open mesh) this is views x non-degenerate triangles.
   std::size_t last_submitted_triangles() const;
+  // Contexts rendering the cameras (see DepthPeelConfig::lanes).
+  int lanes() const;
   // Whether front layers are peeled for the current mesh (see FrontLayers).
   bool peels_front_layers() const;
 
@@ -146,6 +155,7 @@ private:
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  std::unique_ptr<Impl> lane_;  // the second lane's context, or null
 };
 
 }  // namespace sdfkit::vk
