@@ -92,16 +92,19 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// Point i of n of the spherical Fibonacci set on the whole unit sphere (cameras, normal groups).
+glm::dvec3 fibonacci_sphere_point(int i, int n) {
+  const double z = 1.0 - (2.0 * i + 1.0) / n;
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double phi = std::fmod(i * kGoldenAngle, 2.0 * M_PI);
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
 // Spherical Fibonacci directions on the whole sphere, each with an orthonormal image frame.
 std::vector<GpuCamera> make_cameras(int n) {
   std::vector<GpuCamera> cams(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / n;
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = std::fmod(i * kGoldenAngle, 2.0 * M_PI);
-    const glm::vec3 d(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                      static_cast<float>(z));
-    const Frame f = tangent_frame(glm::normalize(d));
+    const Frame f = tangent_frame(glm::normalize(glm::vec3(fibonacci_sphere_point(i, n))));
     cams[static_cast<std::size_t>(i)] = {glm::vec4(f.t, 0.0f), glm::vec4(f.b, 0.0f), glm::vec4(f.axis, 0.0f)};
   }
   return cams;
@@ -123,12 +126,7 @@ constexpr double kBinMarginDegrees = 2.0;
 // the groups (empty ones dropped) and fills `order` with the triangles sorted by group.
 std::vector<NormalBin> bin_normals(std::span<const glm::vec4> normals, int bins, std::vector<std::uint32_t>& order) {
   std::vector<glm::dvec3> axes(static_cast<std::size_t>(bins));
-  for (int i = 0; i < bins; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / bins;
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = std::fmod(i * kGoldenAngle, 2.0 * M_PI);
-    axes[static_cast<std::size_t>(i)] = glm::dvec3(r * std::cos(phi), r * std::sin(phi), z);
-  }
+  for (int i = 0; i < bins; ++i) axes[static_cast<std::size_t>(i)] = fibonacci_sphere_point(i, bins);
   // Draw order: latitude bands, by azimuth within a band, so the groups a camera keeps (a cap
   // of directions) form a few runs, one draw each (about 8 per camera at 128 groups, against
   // 34 in Fibonacci order).
@@ -271,7 +269,18 @@ struct DepthPeelBackend::Impl {
   int last_layers = 0;
 
   explicit Impl(const DepthPeelConfig& c);
-  void upload_geometry(std::span<const glm::vec3> positions);
+  // The host side of a mesh state (which triangles are drawn, in which order, their corners and
+  // normals, the framed sphere); computed once and uploaded into every lane.
+  struct DrawGeometry {
+    std::vector<std::uint32_t> drawn;
+    std::vector<NormalBin> bins;
+    std::vector<glm::vec3> corners;
+    std::vector<glm::vec4> normals;
+    glm::vec3 center{0.0f};
+    float radius = 1.0f;
+  };
+  DrawGeometry prepare_geometry(std::span<const glm::vec3> positions) const;
+  void upload_geometry(const DrawGeometry& geometry);
   void ensure_query_buffers(std::size_t n, std::uint32_t max_samples);
   // Writes the query's points (origin moved inward, inward normal) into `points`.
   void upload_points(const SdfQuery& query);
@@ -404,54 +413,61 @@ void DepthPeelBackend::Impl::grow_nodes(std::size_t capacity) {
   node_capacity = capacity;
 }
 
-void DepthPeelBackend::Impl::upload_geometry(std::span<const glm::vec3> positions) {
+DepthPeelBackend::Impl::DrawGeometry DepthPeelBackend::Impl::prepare_geometry(
+    std::span<const glm::vec3> positions) const {
+  DrawGeometry g;
   // Degenerate triangles are never drawn (never ray targets); the rest keep their order.
-  drawn.clear();
-  std::vector<glm::vec3> corners;
-  std::vector<glm::vec4> normals;
   for (std::size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
     const glm::vec3 a = positions[t[0]], b = positions[t[1]], c = positions[t[2]];
     if (triangle_is_degenerate(a, b, c)) continue;
-    drawn.push_back(static_cast<std::uint32_t>(f));
-    normals.emplace_back(glm::normalize(glm::cross(b - a, c - a)), 0.0f);
+    g.drawn.push_back(static_cast<std::uint32_t>(f));
+    g.normals.emplace_back(glm::normalize(glm::cross(b - a, c - a)), 0.0f);
   }
   // Closed meshes in FragmentLists mode draw back faces only: draw order by normal group, so a
   // camera can skip the groups facing it. Otherwise the input order.
-  bins.clear();
-  if (lists && !front_layers && cfg.normal_bins > 1 && !drawn.empty()) {
+  if (lists && !front_layers && cfg.normal_bins > 1 && !g.drawn.empty()) {
     std::vector<std::uint32_t> order;
-    bins = bin_normals(normals, cfg.normal_bins, order);
-    std::vector<std::uint32_t> sorted_drawn(drawn.size());
-    std::vector<glm::vec4> sorted_normals(normals.size());
+    g.bins = bin_normals(g.normals, cfg.normal_bins, order);
+    std::vector<std::uint32_t> sorted_drawn(g.drawn.size());
+    std::vector<glm::vec4> sorted_normals(g.normals.size());
     for (std::size_t i = 0; i < order.size(); ++i) {
-      sorted_drawn[i] = drawn[order[i]];
-      sorted_normals[i] = normals[order[i]];
+      sorted_drawn[i] = g.drawn[order[i]];
+      sorted_normals[i] = g.normals[order[i]];
     }
-    drawn = std::move(sorted_drawn);
-    normals = std::move(sorted_normals);
+    g.drawn = std::move(sorted_drawn);
+    g.normals = std::move(sorted_normals);
   }
-  corners.reserve(3 * drawn.size());
-  for (std::uint32_t f : drawn)
-    for (std::uint32_t v : triangles[f]) corners.push_back(positions[v]);
+  g.corners.reserve(3 * g.drawn.size());
+  for (std::uint32_t f : g.drawn)
+    for (std::uint32_t v : triangles[f]) g.corners.push_back(positions[v]);
+
+  // Bounding sphere: box centre, farthest vertex (only vertices used by triangles count).
+  g.center = bounding_box(positions).center();
+  float r2 = 0.0f;
+  for (const auto& t : triangles)
+    for (std::uint32_t v : t) {
+      const glm::vec3 d = positions[v] - g.center;
+      r2 = std::max(r2, glm::dot(d, d));
+    }
+  g.radius = std::max(std::sqrt(r2), 1e-20f);
+  return g;
+}
+
+void DepthPeelBackend::Impl::upload_geometry(const DrawGeometry& geometry) {
+  drawn = geometry.drawn;
+  bins = geometry.bins;
+  center = geometry.center;
+  radius = geometry.radius;
   auto upload = [&](Buffer& buf, const void* data, std::size_t bytes, VkBufferUsageFlags usage) {
     const std::size_t alloc = std::max<std::size_t>(bytes, 16);
     if (!buf.buffer || buf.size < alloc) buf = create_buffer(*ctx, alloc, usage, MemoryUse::Upload);
     if (bytes) std::memcpy(buf.mapped(), data, bytes);
   };
-  upload(corner_buffer, corners.data(), corners.size() * sizeof(glm::vec3), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  upload(normal_buffer, normals.data(), normals.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-
-  // Bounding sphere: box centre, farthest vertex (only vertices used by triangles count).
-  const Aabb box = bounding_box(positions);
-  center = box.center();
-  float r2 = 0.0f;
-  for (const auto& t : triangles)
-    for (std::uint32_t v : t) {
-      const glm::vec3 d = positions[v] - center;
-      r2 = std::max(r2, glm::dot(d, d));
-    }
-  radius = std::max(std::sqrt(r2), 1e-20f);
+  upload(corner_buffer, geometry.corners.data(), geometry.corners.size() * sizeof(glm::vec3),
+         VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  upload(normal_buffer, geometry.normals.data(), geometry.normals.size() * sizeof(glm::vec4),
+         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 }
 
 std::uint32_t DepthPeelBackend::Impl::auto_max_samples(float cone_degrees) const {
@@ -789,19 +805,20 @@ std::size_t DepthPeelBackend::device_memory_bytes() const {
 void DepthPeelBackend::set_mesh(const Mesh& mesh) {
   const auto t0 = Clock::now();
   validate_mesh(mesh, "the mesh given to the Vulkan backend");
-  impl_->triangles = mesh.triangles;
-  impl_->vertex_count = mesh.positions.size();
   const MeshReport report = analyze(mesh);
-  impl_->front_layers = impl_->cfg.front_layers == FrontLayers::Always || report.boundary_edges > 0 ||
-                      report.non_manifold_edges > 0;
-  impl_->upload_geometry(mesh.positions);
-  impl_->write_sets();
-  if (lane_) {
-    lane_->triangles = impl_->triangles;
-    lane_->vertex_count = impl_->vertex_count;
-    lane_->front_layers = impl_->front_layers;
-    lane_->upload_geometry(mesh.positions);
-    lane_->write_sets();
+  const bool front_layers = impl_->cfg.front_layers == FrontLayers::Always || report.boundary_edges > 0 ||
+                            report.non_manifold_edges > 0;
+  for (Impl* lane : {impl_.get(), lane_.get()}) {
+    if (!lane) continue;
+    lane->triangles = mesh.triangles;
+    lane->vertex_count = mesh.positions.size();
+    lane->front_layers = front_layers;
+  }
+  const Impl::DrawGeometry geometry = impl_->prepare_geometry(mesh.positions);
+  for (Impl* lane : {impl_.get(), lane_.get()}) {
+    if (!lane) continue;
+    lane->upload_geometry(geometry);
+    lane->write_sets();
   }
   impl_->timings = {{"upload_mesh", ms_since(t0)}};
 }
@@ -812,8 +829,9 @@ void DepthPeelBackend::update_positions(std::span<const glm::vec3> positions) {
     throw Error("update_positions() got " + std::to_string(positions.size()) + " positions for a mesh of " +
                 std::to_string(impl_->vertex_count) + " vertices");
   const auto t0 = Clock::now();
-  impl_->upload_geometry(positions);
-  if (lane_) lane_->upload_geometry(positions);
+  const Impl::DrawGeometry geometry = impl_->prepare_geometry(positions);
+  impl_->upload_geometry(geometry);
+  if (lane_) lane_->upload_geometry(geometry);
   impl_->timings = {{"upload_mesh", ms_since(t0)}};
 }
 
@@ -897,35 +915,35 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   bool cap_hit = false;
   m.last_layers = 0;
   int previous_camera_layers = 1;
-  if (m.lists && lane) {
-    // Two lanes: each context renders its half of the cameras on its own thread (lavapipe bins
-    // on one thread per queue, so the second context's binning overlaps the first one's
-    // rasterization), then the second lane's samples are appended to the first lane's per point.
-    std::vector<PassTiming> lane_gpu;
-    auto other = std::async(std::launch::async, [&] {
-      lane->run_lists(n, max_samples, cos_half, options.false_hit, lane_gpu);
-      lane->stage_samples(n, max_samples, lane_gpu);
-    });
-    std::exception_ptr failure;
-    try {
-      m.run_lists(n, max_samples, cos_half, options.false_hit, gpu);
-      m.stage_samples(n, max_samples, gpu);
-    } catch (...) {
-      failure = std::current_exception();
-    }
-    other.get();  // rethrows the lane's failure
-    if (failure) std::rethrow_exception(failure);
-    gpu.insert(gpu.end(), lane_gpu.begin(), lane_gpu.end());
-    for (const std::string& message : lane->ctx->validation_messages())
-      m.ctx->report_validation_message(VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT, ("(second lane) " + message).c_str());
-    lane->ctx->clear_validation_messages();
-    m.append_lane_samples(*lane, n, max_samples);
-    m.last_layers = 1;
-  } else if (m.lists) {
-    m.run_lists(n, max_samples, cos_half, options.false_hit, gpu);
-    m.last_layers = 1;
-  }
   if (m.lists) {
+    if (lane) {
+      // Two lanes: each context renders its half of the cameras on its own thread (lavapipe
+      // bins on one thread per queue, so the second context's binning overlaps the first one's
+      // rasterization), then the second lane's samples are appended to the first lane's per point.
+      std::vector<PassTiming> lane_gpu;
+      auto other = std::async(std::launch::async, [&] {
+        lane->run_lists(n, max_samples, cos_half, options.false_hit, lane_gpu);
+        lane->stage_samples(n, max_samples, lane_gpu);
+      });
+      std::exception_ptr failure;
+      try {
+        m.run_lists(n, max_samples, cos_half, options.false_hit, gpu);
+        m.stage_samples(n, max_samples, gpu);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      other.get();  // rethrows the lane's failure
+      if (failure) std::rethrow_exception(failure);
+      gpu.insert(gpu.end(), lane_gpu.begin(), lane_gpu.end());
+      for (const std::string& message : lane->ctx->validation_messages())
+        m.ctx->report_validation_message(VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+                                         ("(second lane) " + message).c_str());
+      lane->ctx->clear_validation_messages();
+      m.append_lane_samples(*lane, n, max_samples);
+    } else {
+      m.run_lists(n, max_samples, cos_half, options.false_hit, gpu);
+    }
+    m.last_layers = 1;
     const std::size_t dropped = m.dropped + (lane ? lane->dropped : 0);
     const std::size_t capacity = std::max(m.node_capacity, lane ? lane->node_capacity : 0);
     if (dropped > 0)
