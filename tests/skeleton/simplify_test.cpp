@@ -5,6 +5,8 @@
 
 #include "simplify.hpp"
 
+#include "analytic.hpp"
+
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/core/topology.hpp"
 #include "sdfkit/skeleton/models.hpp"
@@ -30,14 +32,6 @@ long euler_characteristic(const Mesh& m) {
     for (int k = 0; k < 3; ++k) edges.insert({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
   return static_cast<long>(m.positions.size()) - static_cast<long>(edges.size()) +
          static_cast<long>(m.triangles.size());
-}
-
-double signed_volume(const Mesh& m) {
-  double v = 0.0;
-  for (const Triangle& t : m.triangles)
-    v += glm::dot(glm::dvec3(m.positions[t[0]]),
-                  glm::cross(glm::dvec3(m.positions[t[1]]), glm::dvec3(m.positions[t[2]]))) / 6.0;
-  return v;
 }
 
 // Everything the contraction needs from a proxy of `input`, and the vertex map's totality.
@@ -81,7 +75,7 @@ void expect_valid_proxy(const Mesh& input, const detail::Simplified& s, std::siz
   EXPECT_LT(farthest, 2.0 * edge);
   for (int h : hit) EXPECT_GT(h, 0);
   // The enclosed volume stays close: a shape-preserving simplification, not a collapse.
-  EXPECT_NEAR(signed_volume(m) / signed_volume(input), 1.0, 0.1);
+  EXPECT_NEAR(test::signed_volume(m) / test::signed_volume(input), 1.0, 0.1);
 }
 
 }  // namespace
@@ -134,7 +128,7 @@ TEST(SkeletonSimplify, AnUnreachableTargetStopsAtTheSmallestLegalMesh) {
   EXPECT_EQ(r.non_manifold_edges, 0u);
   EXPECT_EQ(r.degenerate_faces, 0u);
   EXPECT_EQ(euler_characteristic(s.mesh), 2);
-  EXPECT_GT(signed_volume(s.mesh), 0.0);  // still facing outward
+  EXPECT_GT(test::signed_volume(s.mesh), 0.0);  // still facing outward
 }
 
 TEST(SkeletonSimplify, ATargetAboveTheVertexCountChangesNothing) {
