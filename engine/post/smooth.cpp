@@ -1,6 +1,7 @@
 #include "sdfkit/post/smooth.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/parallel.hpp"
 #include "sdfkit/core/topology.hpp"
 
 #include <glm/geometric.hpp>
@@ -10,7 +11,6 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
-#include <thread>
 
 namespace sdfkit {
 
@@ -74,10 +74,6 @@ std::vector<float> smooth_field(const Mesh& mesh, SdfDomain domain, std::span<co
   if (!(sigma > 0.0f) || n == 0) return out;
   const float inv_two_sigma2 = 1.0f / (2.0f * sigma * sigma);
 
-  unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
-                                         : std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, n / 4096)));
-
   auto work = [&](std::size_t begin, std::size_t end) {
     // Breadth-first rings with a visit stamp per point (no clearing between points); the
     // neighbourhood is collected first and weighted in a second, branch-free loop.
@@ -115,17 +111,7 @@ std::vector<float> smooth_field(const Mesh& mesh, SdfDomain domain, std::span<co
       out[i] = vsum / wsum;
     }
   };
-  if (threads <= 1) {
-    work(0, n);
-  } else {
-    std::vector<std::thread> pool;
-    const std::size_t chunk = (n + threads - 1) / threads;
-    for (unsigned t = 0; t < threads; ++t) {
-      const std::size_t b = t * chunk, e = std::min(n, b + chunk);
-      if (b < e) pool.emplace_back(work, b, e);
-    }
-    for (auto& th : pool) th.join();
-  }
+  parallel_for(n, work, 4096, options.threads > 0 ? static_cast<unsigned>(options.threads) : 0u);
   return out;
 }
 

@@ -5,13 +5,13 @@
 
 #include "bvh.hpp"
 #include "laplacian.hpp"
-#include "parallel.hpp"
 #include "simplify.hpp"
 #include "surgery.hpp"
 #include "validate.hpp"
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/log.hpp"
+#include "sdfkit/core/parallel.hpp"
 #include "sdfkit/core/topology.hpp"
 
 #include <glm/geometric.hpp>
@@ -54,7 +54,7 @@ struct Surface {
     // otherwise (no SDF, or a vertex on a sharp edge whose cone estimate points past a
     // concavity) an inside point the vertex sees (see seen_inside_point).
     centre.resize(o.positions.size());
-    detail::parallel_for(o.positions.size(), [&](std::size_t begin, std::size_t end) {
+    parallel_for(o.positions.size(), [&](std::size_t begin, std::size_t end) {
       for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
         const glm::vec3 u = o.positions[k];
         if (!sdf.empty()) {
@@ -308,7 +308,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   std::vector<std::uint32_t> choice(n);
   std::vector<std::uint8_t> has_sheet_point(n, 0);
   std::vector<glm::vec3> sheet_point(n);
-  detail::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
     for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
       choice[k] = owner[k];
       if (surface.sees(k, position[owner[k]])) continue;
@@ -456,7 +456,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
     if (!sheet_edges.count(e)) sk.edges.push_back(e);
 
   std::vector<std::uint8_t> sees_node(n, 0);
-  detail::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
     for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k)
       sees_node[k] = surface.sees(k, sk.nodes[node_of_vertex[k]].position);
   });
