@@ -3,6 +3,7 @@
 #include "cl_api.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/mesh.hpp"
 
 #include <glm/common.hpp>
 #include <glm/vec4.hpp>
@@ -122,16 +123,11 @@ std::uint32_t morton3(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& 
 
 // The query's point indices sorted along a Morton curve of their positions (ties by index).
 std::vector<std::uint32_t> spatial_order(std::span<const glm::vec3> points) {
-  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-  for (const glm::vec3& p : points) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  const glm::vec3 extent = glm::max(hi - lo, glm::vec3(std::numeric_limits<float>::min()));
-  const glm::vec3 inv = 1.0f / extent;
+  const Aabb box = bounding_box(points);
+  const glm::vec3 inv = 1.0f / glm::max(box.extent(), glm::vec3(std::numeric_limits<float>::min()));
   std::vector<std::uint64_t> keyed(points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
-    keyed[i] = (std::uint64_t{morton3(points[i], lo, inv)} << 32) | i;
+    keyed[i] = (std::uint64_t{morton3(points[i], box.min, inv)} << 32) | i;
   std::sort(keyed.begin(), keyed.end());
   std::vector<std::uint32_t> order(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
