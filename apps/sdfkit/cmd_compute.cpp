@@ -87,12 +87,9 @@ void add_compute_command(CLI::App& app) {
     std::printf("%s: %zu vertices, %zu faces (%zu welded vertices) -> %s\n", r.input.c_str(),
                 r.input_vertices, r.input_faces, r.welded_vertices, r.output.c_str());
     std::printf("backend %s on %s\n", r.backend.c_str(), r.device.c_str());
-    double total = 0;
-    for (const StageTiming& s : r.stages) {
+    for (const StageTiming& s : r.stages)
       std::printf("  %-16s %10.1f ms%s\n", s.stage.c_str(), s.milliseconds, s.nested ? " (device pass, counted in its stage)" : "");
-      if (!s.nested) total += s.milliseconds;
-    }
-    std::printf("  %-16s %10.1f ms\n", "total", total);
+    std::printf("  %-16s %10.1f ms\n", "total", total_milliseconds(r.stages));
     std::printf("SDF min %g  median %g  mean %g  max %g (model units); %zu of %zu points filled\n",
                 r.summary.min, r.summary.median, r.summary.mean, r.summary.max, r.filled_points, r.points);
     for (const std::string& w : r.warnings) std::fprintf(stderr, "sdfkit: warning: %s\n", w.c_str());

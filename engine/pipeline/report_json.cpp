@@ -6,11 +6,7 @@ namespace sdfkit {
 
 std::string report_to_json(const ComputeReport& r, const std::string& error, const std::string& fingerprint) {
   nlohmann::json stages = nlohmann::json::object();
-  double total = 0;
-  for (const StageTiming& s : r.stages) {
-    stages[s.stage] = s.milliseconds;
-    if (!s.nested) total += s.milliseconds;
-  }
+  for (const StageTiming& s : r.stages) stages[s.stage] = s.milliseconds;
   nlohmann::json j = {
       {"input", r.input},
       {"output", r.output},
@@ -22,7 +18,7 @@ std::string report_to_json(const ComputeReport& r, const std::string& error, con
       {"backend", r.backend},
       {"device", r.device},
       {"time_ms", stages},
-      {"total_ms", total},
+      {"total_ms", total_milliseconds(r.stages)},
       {"summary",
        {{"min", r.summary.min}, {"median", r.summary.median}, {"mean", r.summary.mean}, {"max", r.summary.max}}},
       {"warnings", r.warnings},

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,14 @@ struct StageTiming {
   // A part of another stage (the device time of one pass, "gpu_*"), not added to totals.
   bool nested = false;
 };
+
+// The sum of the stages that are not nested in another.
+inline double total_milliseconds(std::span<const StageTiming> stages) {
+  double total = 0.0;
+  for (const StageTiming& s : stages)
+    if (!s.nested) total += s.milliseconds;
+  return total;
+}
 
 // Every backend implements this. A backend object is a session: it keeps its device context,
 // compiled programs and uploaded geometry between calls.
