@@ -52,6 +52,7 @@ void add_skeleton_command(CLI::App& app) {
   cmd->add_option("--iterations", a->iterations, "Contraction iteration cap")->check(CLI::Range(1, 200));
   cmd->add_option("--proxy-vertices", a->proxy_vertices,
                   "Contract a simplified proxy of at most this many vertices when the mesh has more (0 = contract the mesh itself)")
+      ->check(CLI::Range(0, 1000000000))
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
   add_sdf_options(*cmd, a->sdf);

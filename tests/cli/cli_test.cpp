@@ -126,9 +126,13 @@ TEST_F(Cli, FailedComputeWritesNothingAndKeepsAnExistingFile) {
 }
 
 TEST_F(Cli, BadOptionValuesAreUsageErrors) {
-  const RunResult r = run("compute builtin:sphere -o x.txt --rays 0");
-  EXPECT_FALSE(r.signaled);
-  EXPECT_EQ(r.exit_code, 2);
+  // A negative proxy size must not wrap around to a huge unsigned value and run.
+  for (const char* cmd : {"compute builtin:sphere -o x.txt --rays 0", "skeleton builtin:capsule -o s.json --proxy-vertices -5"}) {
+    const RunResult r = run(cmd);
+    EXPECT_FALSE(r.signaled) << cmd;
+    EXPECT_EQ(r.exit_code, 2) << cmd << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "s.json"));
   EXPECT_EQ(run("--help").exit_code, 0);
 }
 
