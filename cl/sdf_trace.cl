@@ -216,56 +216,64 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
 }
 
 #ifdef SDFKIT_BVH
-// Packets: one work item traces PACKET rays of one point together (they share the origin), as
-// OpenCL vectors, so a CPU device runs each box and triangle test for all of them in one SIMD
-// instruction stream. Rays of the packet beyond n_rays are inactive (best distance -1: nothing
-// can be entered or hit). A node is entered when any active ray enters it; pending nodes keep
-// the smallest entry distance of their rays and are dropped once every ray has a closer hit.
-#define PACKET 8
-// The packet's triangle test rounds like the scalar one and the C++ definition's tests: no
+// Bundles: one work item traces ray r of BUNDLE consecutive points (the host sorts the points
+// in Morton order, so these are neighbours on the surface) as float16 lanes, so a CPU device
+// runs each box and triangle test for all of them in one SIMD instruction stream: nearly
+// parallel rays from nearby origins, every lane busy whatever the ray count. Lanes past the
+// last point or of points that cast no rays are inactive (best distance -1: nothing can be
+// entered or hit). A node is entered when any active ray enters it; pending nodes keep the
+// smallest entry distance of their rays and are dropped once every ray has a closer hit.
+#define BUNDLE 16  // = kBundle in opencl_backend.cpp
+// The bundle's triangle test rounds like the scalar one and the C++ definition's tests: no
 // contraction (with fma, rays through a shared edge of an axis-aligned face slipped between
 // both triangles).
 #pragma OPENCL FP_CONTRACT OFF
 
-// Entry distances of the packet's rays into a box (min corner lo, max corner hi), and in
-// *enter which rays enter it before their closest hit so far (min/max: no NaN can occur).
-inline float8 packet_entry(float4 lo, float4 hi, float3 o, float8 ix, float8 iy, float8 iz,
-                           float8 best_t, int8* enter) {
-  const float8 ax = (lo.x - o.x) * ix, bx = (hi.x - o.x) * ix;
-  const float8 ay = (lo.y - o.y) * iy, by = (hi.y - o.y) * iy;
-  const float8 az = (lo.z - o.z) * iz, bz = (hi.z - o.z) * iz;
-  const float8 tin = max(max(max(min(ax, bx), min(ay, by)), min(az, bz)), (float8)0.0f);
-  const float8 tout = min(min(min(max(ax, bx), max(ay, by)), max(az, bz)), best_t);
-  *enter = tin <= tout;
-  return tin;
+// (min over a's lanes, min over b's lanes), folded pairwise.
+inline float2 pair_min(float16 a, float16 b) {
+  const float16 m16 = min((float16)(a.lo, b.lo), (float16)(a.hi, b.hi));
+  const float8 m8 = min(m16.s012389ab, m16.s4567cdef);
+  const float4 m4 = min(m8.s0145, m8.s2367);
+  return (float2)(min(m4.x, m4.y), min(m4.z, m4.w));
 }
 
-// The smallest entry distance over the rays in `mask` (INFINITY when none).
-inline float packet_min(float8 t, int8 mask) {
-  const float8 m = select((float8)INFINITY, t, mask);
-  const float4 m4 = min(m.lo, m.hi);
-  return min(min(m4.x, m4.y), min(m4.z, m4.w));
+inline float lane_max(float16 t) {
+  const float8 m8 = max(t.lo, t.hi);
+  const float4 m4 = max(m8.lo, m8.hi);
+  return max(max(m4.x, m4.y), max(m4.z, m4.w));
 }
 
-// Closest hits of the packet: per lane the hit record (0xffffffff = none) and distance.
-inline void closest_hits_packet(__global const float4* bvh, __global const float4* tris,
-                                float3 o, float8 dx, float8 dy, float8 dz, int8 active,
-                                uint8* f_out, float8* t_out) {
+// Per ray of a bundle (origins per lane), the entry distance into a box or INFINITY.
+inline float16 bundle_entry(float4 lo, float4 hi, float16 ox, float16 oy, float16 oz,
+                            float16 ix, float16 iy, float16 iz, float16 best_t) {
+  const float16 ax = (lo.x - ox) * ix, bx = (hi.x - ox) * ix;
+  const float16 ay = (lo.y - oy) * iy, by = (hi.y - oy) * iy;
+  const float16 az = (lo.z - oz) * iz, bz = (hi.z - oz) * iz;
+  const float16 tin = max(max(max(min(ax, bx), min(ay, by)), min(az, bz)), (float16)0.0f);
+  const float16 tout = min(min(min(max(ax, bx), max(ay, by)), max(az, bz)), best_t);
+  return select((float16)INFINITY, tin, tin <= tout);
+}
+
+// Closest hits of the bundle: per lane the hit record (0xffffffff = none) and distance.
+inline void closest_hits_bundle(__global const float4* bvh, __global const float4* tris,
+                                float16 ox, float16 oy, float16 oz, float16 dx, float16 dy,
+                                float16 dz, int16 active, uint16* f_out, float16* t_out) {
   const float tiny = 1e-20f;
-  const float8 ix = 1.0f / select(dx, copysign((float8)tiny, dx), fabs(dx) < tiny);
-  const float8 iy = 1.0f / select(dy, copysign((float8)tiny, dy), fabs(dy) < tiny);
-  const float8 iz = 1.0f / select(dz, copysign((float8)tiny, dz), fabs(dz) < tiny);
-  float8 best_t = select((float8)(-1.0f), (float8)INFINITY, active);
-  uint8 best_f = (uint8)0xffffffffu;
+  const float16 ix = 1.0f / select(dx, copysign((float16)tiny, dx), fabs(dx) < tiny);
+  const float16 iy = 1.0f / select(dy, copysign((float16)tiny, dy), fabs(dy) < tiny);
+  const float16 iz = 1.0f / select(dz, copysign((float16)tiny, dz), fabs(dz) < tiny);
+  float16 best_t = select((float16)(-1.0f), (float16)INFINITY, active);
+  uint16 best_f = (uint16)0xffffffffu;
   *f_out = best_f;
   *t_out = best_t;
-  int8 enter;
-  (void)packet_entry(bvh[0], bvh[1], o, ix, iy, iz, best_t, &enter);
-  if (!any(enter)) return;
   uint stack_node[BVH_STACK_SIZE];
   float stack_t[BVH_STACK_SIZE];
   int sp = 0;
-  uint node = 0;  // entered by some ray
+  uint node = 0;
+  {
+    const float16 root = bundle_entry(bvh[0], bvh[1], ox, oy, oz, ix, iy, iz, best_t);
+    if (!(pair_min(root, root).x < INFINITY)) return;
+  }
   for (;;) {
     const uint word = as_uint(bvh[2 * node].w), count = as_uint(bvh[2 * node + 1].w);
     bool descend = false;
@@ -273,31 +281,32 @@ inline void closest_hits_packet(__global const float4* bvh, __global const float
       const uint end = word + (count & ~LEAF_BIT);
       for (uint k = word; k < end; ++k) {
         const float4 v0 = tris[3 * k], e1 = tris[3 * k + 1], e2 = tris[3 * k + 2];
-        // Moller-Trumbore for all lanes; q = cross(o - v0, e1) is shared by the packet.
-        const float8 px = dy * e2.z - dz * e2.y, py = dz * e2.x - dx * e2.z,
-                     pz = dx * e2.y - dy * e2.x;
-        const float8 det = e1.x * px + e1.y * py + e1.z * pz;
-        const float8 inv_det = 1.0f / det;
-        const float tx = o.x - v0.x, ty = o.y - v0.y, tz = o.z - v0.z;
-        const float8 u = (tx * px + ty * py + tz * pz) * inv_det;
-        const float qx = ty * e1.z - tz * e1.y, qy = tz * e1.x - tx * e1.z,
-                    qz = tx * e1.y - ty * e1.x;
-        const float8 v = (dx * qx + dy * qy + dz * qz) * inv_det;
-        const float8 t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
-        const int8 hit = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
-                         (u + v <= 1.0f) & (t > 0.0f) & (t < best_t);
+        const float16 px = dy * e2.z - dz * e2.y, py = dz * e2.x - dx * e2.z,
+                      pz = dx * e2.y - dy * e2.x;
+        const float16 det = e1.x * px + e1.y * py + e1.z * pz;
+        const float16 inv_det = 1.0f / det;
+        const float16 tx = ox - v0.x, ty = oy - v0.y, tz = oz - v0.z;
+        const float16 u = (tx * px + ty * py + tz * pz) * inv_det;
+        const float16 qx = ty * e1.z - tz * e1.y, qy = tz * e1.x - tx * e1.z,
+                      qz = tx * e1.y - ty * e1.x;
+        const float16 v = (dx * qx + dy * qy + dz * qz) * inv_det;
+        const float16 t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
+        const int16 hit = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
+                          (u + v <= 1.0f) & (t > 0.0f) & (t < best_t);
         best_t = select(best_t, t, hit);
-        best_f = select(best_f, (uint8)k, as_uint8(hit));
+        best_f = select(best_f, (uint16)k, as_uint16(hit));
       }
     } else {
       const uint a = node + 1, b = word;
-      int8 ea, eb;
-      const float8 ta = packet_entry(bvh[2 * a], bvh[2 * a + 1], o, ix, iy, iz, best_t, &ea);
-      const float8 tb = packet_entry(bvh[2 * b], bvh[2 * b + 1], o, ix, iy, iz, best_t, &eb);
-      const bool hit_a = any(ea), hit_b = any(eb);
+      const float16 ta =
+          bundle_entry(bvh[2 * a], bvh[2 * a + 1], ox, oy, oz, ix, iy, iz, best_t);
+      const float16 tb =
+          bundle_entry(bvh[2 * b], bvh[2 * b + 1], ox, oy, oz, ix, iy, iz, best_t);
+      const float2 m2 = pair_min(ta, tb);
+      const float a_min = m2.x, b_min = m2.y;
+      const bool hit_a = a_min < INFINITY, hit_b = b_min < INFINITY;
       if (hit_a || hit_b) {
-        const float a_min = packet_min(ta, ea), b_min = packet_min(tb, eb);
-        const bool a_first = hit_a && (!hit_b || a_min <= b_min);
+        const bool a_first = a_min <= b_min;
         if (hit_a && hit_b && sp < BVH_STACK_SIZE) {
           stack_node[sp] = a_first ? b : a;
           stack_t[sp] = a_first ? b_min : a_min;
@@ -308,9 +317,6 @@ inline void closest_hits_packet(__global const float4* bvh, __global const float
       }
     }
     if (descend) continue;
-    // Pop a pending node that some ray may still enter before its closest hit.
-    const float4 m4 = max(best_t.lo, best_t.hi);
-    const float farthest = max(max(m4.x, m4.y), max(m4.z, m4.w));
     for (;;) {
       if (sp == 0) {
         *f_out = best_f;
@@ -318,7 +324,8 @@ inline void closest_hits_packet(__global const float4* bvh, __global const float
         return;
       }
       --sp;
-      if (stack_t[sp] <= farthest) {
+      // A pending node is kept while some ray may still enter it before its closest hit.
+      if (stack_t[sp] <= lane_max(best_t)) {
         node = stack_node[sp];
         break;
       }
@@ -326,52 +333,44 @@ inline void closest_hits_packet(__global const float4* bvh, __global const float
   }
 }
 
-// One work item per PACKET consecutive rays of one point; writes their keys like trace_rays.
-// `order` lists the ray indices slot by slot (the host groups rays of similar azimuth into
-// the same packet, so a packet's rays stay close together).
-__kernel void trace_packets(__global const float4* bvh, __global const float4* tris,
+// One work item per (bundle, ray); writes the keys of its lanes like trace_rays.
+__kernel void trace_bundles(__global const float4* bvh, __global const float4* tris,
                             __global const float4* points, __global const float4* normals,
-                            __global const float4* table, __global const uint* order,
-                            int n_rays, uint n_points, float origin_offset, int rule,
-                            __global ulong* keys) {
-  // ceil(n / PACKET) packets per point, the rays spread evenly over them (25 rays: 7+6+6+6,
-  // not 8+8+8+1), so every packet is a wedge of about the same width.
-  const uint packets = ((uint)n_rays + PACKET - 1) / PACKET;
-  const uint per = ((uint)n_rays + packets - 1) / packets;
+                            __global const float4* table, int n_rays, uint n_points,
+                            float origin_offset, int rule, __global ulong* keys) {
+  const uint bundles = (n_points + BUNDLE - 1) / BUNDLE;
   const uint g = get_global_id(0);
-  if (g >= n_points * packets) return;
-  const uint p = g / packets, first = (g - p * packets) * per;
-  const float4 pt = points[p];
-  const uint lanes = min(per, (uint)n_rays - first);
-  if (pt.w == 0.0f) {
-    for (uint l = 0; l < lanes; ++l) keys[(size_t)p * n_rays + order[first + l]] = NO_HIT_KEY;
-    return;
+  if (g >= bundles * (uint)n_rays) return;
+  const uint bundle = g / (uint)n_rays, r = g - bundle * (uint)n_rays;
+  const uint first = bundle * BUNDLE, lanes = min((uint)BUNDLE, n_points - first);
+  const float3 cone_dir = table[r].xyz;
+  float oxs[BUNDLE], oys[BUNDLE], ozs[BUNDLE], dxs[BUNDLE], dys[BUNDLE], dzs[BUNDLE];
+  int act[BUNDLE];
+  for (uint l = 0; l < BUNDLE; ++l) {
+    const uint p = first + min(l, lanes - 1);
+    const float4 pt = points[p];
+    const float3 n = normals[p].xyz;
+    const float3 d = ray_direction(n, cone_dir);
+    const float3 o = pt.xyz - origin_offset * n;
+    oxs[l] = o.x; oys[l] = o.y; ozs[l] = o.z;
+    dxs[l] = d.x; dys[l] = d.y; dzs[l] = d.z;
+    act[l] = (l < lanes && pt.w != 0.0f) ? -1 : 0;
   }
-  const float3 n = normals[p].xyz;
-  const float3 o = pt.xyz - origin_offset * n;
-  float dxs[PACKET], dys[PACKET], dzs[PACKET];
-  int act[PACKET];
-  for (uint l = 0; l < PACKET; ++l) {
-    const float3 d = ray_direction(n, table[order[first + min(l, lanes - 1)]].xyz);
-    dxs[l] = d.x;
-    dys[l] = d.y;
-    dzs[l] = d.z;
-    act[l] = l < lanes ? -1 : 0;
-  }
-  const float8 dx = vload8(0, dxs), dy = vload8(0, dys), dz = vload8(0, dzs);
-  const int8 active = vload8(0, act);
-  uint8 f8;
-  float8 t8;
-  closest_hits_packet(bvh, tris, o, dx, dy, dz, active, &f8, &t8);
-  uint fs[PACKET];
-  float ts[PACKET];
-  vstore8(f8, 0, fs);
-  vstore8(t8, 0, ts);
+  uint16 f16;
+  float16 t16;
+  closest_hits_bundle(bvh, tris, vload16(0, oxs), vload16(0, oys), vload16(0, ozs),
+                      vload16(0, dxs), vload16(0, dys), vload16(0, dzs), vload16(0, act), &f16,
+                      &t16);
+  uint fs[BUNDLE];
+  float ts[BUNDLE];
+  vstore16(f16, 0, fs);
+  vstore16(t16, 0, ts);
   for (uint l = 0; l < lanes; ++l) {
-    const uint r = order[first + l];
+    const uint p = first + l;
     ulong key = NO_HIT_KEY;
     const uint f = fs[l];
-    if (f != 0xffffffffu) {
+    if (act[l] && f != 0xffffffffu) {
+      const float3 n = normals[p].xyz;
       const float3 hn = (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
       const float3 d = (float3)(dxs[l], dys[l], dzs[l]);
       const bool accept = rule == 0 ? dot(hn, n) <= 0.0f : dot(d, hn) > 0.0f;

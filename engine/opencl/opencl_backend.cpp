@@ -99,6 +99,8 @@ void set_args(cl_kernel kernel, const char* kernel_name, const Args&... args) {
 // of trace and gather against 14-15 ms with 16-64; CGAL's hand at 8 rays: 5.6 ms against 2.6 ms;
 // armadillo per face: 2-5 % less).
 constexpr std::size_t kCpuWorkGroup = 32;
+// Points per work item of trace_bundles (BUNDLE in cl/sdf_trace.cl).
+constexpr std::size_t kBundle = 16;
 
 std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m - 1) / m * m; }
 
@@ -151,8 +153,8 @@ struct OpenClBackend::Impl {
   detail::Context context;
   detail::Queue queue;
   detail::Program program;
-  detail::Kernel k_cone, k_trace, k_packets, k_gather, k_dirs;
-  bool packets = false;  // BVH traced by trace_packets
+  detail::Kernel k_cone, k_trace, k_bundles, k_gather, k_dirs;
+  bool bundles = false;  // BVH traced by trace_bundles
   std::size_t local_size = 0;  // work-group size of the trace and gather kernels (0 = driver's)
 
   // Geometry (resident between computes).
@@ -164,7 +166,7 @@ struct OpenClBackend::Impl {
   std::size_t geometry_bytes = 0;
 
   // The cone table of the last (rays, cone) and the per-batch buffers.
-  detail::Buffer table, ray_order;
+  detail::Buffer table;
   int table_rays = 0;
   float table_cone = 0.0f;
   detail::Buffer points, normals, keys, values, kept;
@@ -208,9 +210,9 @@ void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
   build_program();
   k_cone = make_kernel("make_cone");
   k_trace = make_kernel("trace_rays");
-  packets = cfg.accel == Accel::Bvh && cfg.bvh_packets.value_or(info.type == "CPU");
+  bundles = cfg.accel == Accel::Bvh && cfg.bvh_bundles.value_or(info.type == "CPU");
   local_size = cfg.work_group_size > 0 ? cfg.work_group_size : (info.type == "CPU" ? kCpuWorkGroup : 0);
-  if (packets) k_packets = make_kernel("trace_packets");
+  if (bundles) k_bundles = make_kernel("trace_bundles");
   k_gather = make_kernel("gather_points");
   k_dirs = make_kernel("ray_directions");
 }
@@ -325,20 +327,6 @@ void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
   const cl_mem t = table.get();
   set_args(k_cone.get(), "make_cone", cl_int{rays}, one_minus_cos, f_hi, f_lo, t);
   run(k_cone.get(), static_cast<std::size_t>(rays), 0, "make_cone");
-  // Packet order: the rays sorted by azimuth (phi_i = i * golden angle), so each packet of
-  // consecutive slots is a wedge of the cone whose rays meet nearby triangles. Only the order
-  // in which rays are traced changes; every ray keeps its index and weight.
-  std::vector<cl_uint> order(static_cast<std::size_t>(rays));
-  std::vector<double> phi(order.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    order[i] = static_cast<cl_uint>(i);
-    phi[i] = std::fmod(static_cast<double>(i) * kGoldenAngle, 2.0 * M_PI);
-  }
-  std::stable_sort(order.begin(), order.end(), [&](cl_uint a, cl_uint b) { return phi[a] < phi[b]; });
-  ray_order.reserve(context.get(), order.size() * sizeof(cl_uint), CL_MEM_READ_ONLY, "the ray order");
-  check(clEnqueueWriteBuffer(queue.get(), ray_order.get(), CL_TRUE, 0, order.size() * sizeof(cl_uint),
-                             order.data(), 0, nullptr, nullptr),
-        "uploading the ray order");
   table_rays = rays;
   table_cone = cone_degrees;
 }
@@ -437,14 +425,12 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
     const auto count32 = static_cast<cl_uint>(count);
     m.write(m.points.get(), count * sizeof(cl_float4), &pts[first], "query points");
     m.write(m.normals.get(), count * sizeof(cl_float4), &nrm[first], "query normals");
-    if (m.packets) {
-      // Packets of kPacket rays of one point per work item (cl/sdf_trace.cl).
-      constexpr std::size_t kPacket = 8;
-      set_args(m.k_packets.get(), "trace_packets", m.cells.get(), m.tris.get(), m.points.get(),
-               m.normals.get(), m.table.get(), m.ray_order.get(), cl_int{rays}, count32, query.origin_offset, rule,
+    if (m.bundles) {
+      // Ray r of kBundle Morton-neighbouring points per work item (cl/sdf_trace.cl).
+      set_args(m.k_bundles.get(), "trace_bundles", m.cells.get(), m.tris.get(), m.points.get(),
+               m.normals.get(), m.table.get(), cl_int{rays}, count32, query.origin_offset, rule,
                m.keys.get());
-      m.run(m.k_packets.get(), count * ((nr + kPacket - 1) / kPacket), m.local_size,
-            "trace_packets");
+      m.run(m.k_bundles.get(), (count + kBundle - 1) / kBundle * nr, m.local_size, "trace_bundles");
     } else {
       set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.tris.get(),
                m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,

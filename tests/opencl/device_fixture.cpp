@@ -7,7 +7,7 @@ namespace sdfkit::test {
 
 const char* tracer_name(Tracer t) {
   switch (t) {
-    case Tracer::BvhPackets: return "BvhPackets";
+    case Tracer::BvhBundles: return "BvhBundles";
     case Tracer::BvhSingle: return "BvhSingle";
     case Tracer::Octree: return "Octree";
   }
@@ -22,7 +22,7 @@ cl::OpenClBackend* opencl_backend(Tracer tracer) {
   if (!b) {
     cl::OpenClConfig config;
     config.accel = tracer == Tracer::Octree ? cl::Accel::Octree : cl::Accel::Bvh;
-    config.bvh_packets = tracer == Tracer::BvhPackets;
+    config.bvh_bundles = tracer == Tracer::BvhBundles;
     b = std::make_unique<cl::OpenClBackend>(config);
   }
   return b.get();

@@ -10,20 +10,20 @@
 
 namespace sdfkit::test {
 
-// The tracer variants the tests cover: the BVH with packets of 8 rays (the default on CPU
-// devices), the BVH with one ray per work item (the default on GPUs), the octree.
-enum class Tracer { BvhPackets, BvhSingle, Octree };
+// The tracer variants the tests cover: the BVH with bundles of 16 points per ray (the default
+// on CPU devices), the BVH with one ray per work item (the default on GPUs), the octree.
+enum class Tracer { BvhBundles, BvhSingle, Octree };
 const char* tracer_name(Tracer t);
 
 // The shared backend of that variant, or nullptr when no device exists (use SDFKIT_REQUIRE_CL
 // / SDFKIT_REQUIRE_CL_ACCEL, which fail or skip the test then).
-cl::OpenClBackend* opencl_backend(Tracer tracer = Tracer::BvhPackets);
+cl::OpenClBackend* opencl_backend(Tracer tracer = Tracer::BvhBundles);
 
 }  // namespace sdfkit::test
 
 // Binds `var` to the shared backend; fails (or skips, with SDFKIT_ALLOW_NO_DEVICE=1) the test
 // when there is no OpenCL device.
-#define SDFKIT_REQUIRE_CL(var) SDFKIT_REQUIRE_CL_ACCEL(var, ::sdfkit::test::Tracer::BvhPackets)
+#define SDFKIT_REQUIRE_CL(var) SDFKIT_REQUIRE_CL_ACCEL(var, ::sdfkit::test::Tracer::BvhBundles)
 #define SDFKIT_REQUIRE_CL_ACCEL(var, tracer)                               \
   cl::OpenClBackend* var##_ptr = ::sdfkit::test::opencl_backend(tracer);   \
   if (var##_ptr == nullptr) {                                             \

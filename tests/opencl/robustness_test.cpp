@@ -148,7 +148,7 @@ TEST_P(OpenClUpdate, UpdatePositionsEqualsFreshSetMesh) {
   EXPECT_THROW(backend.update_positions(std::vector<glm::vec3>(3)), Error);
 }
 
-INSTANTIATE_TEST_SUITE_P(Tracer, OpenClUpdate, ::testing::Values(test::Tracer::BvhPackets, test::Tracer::BvhSingle, test::Tracer::Octree),
+INSTANTIATE_TEST_SUITE_P(Tracer, OpenClUpdate, ::testing::Values(test::Tracer::BvhBundles, test::Tracer::BvhSingle, test::Tracer::Octree),
                          [](const auto& p) { return std::string(test::tracer_name(p.param)); });
 
 TEST(OpenClRobustness, SmallMemoryCapBatchesWithoutChangingResults) {

@@ -96,5 +96,5 @@ TEST_P(OpenClTrace, ClosestHitEqualsBruteForceOnCellPlanes) {
   expect_closest_hits(backend, shapes::icosphere(1.0f, 3));
 }
 
-INSTANTIATE_TEST_SUITE_P(Tracer, OpenClTrace, ::testing::Values(test::Tracer::BvhPackets, test::Tracer::BvhSingle, test::Tracer::Octree),
+INSTANTIATE_TEST_SUITE_P(Tracer, OpenClTrace, ::testing::Values(test::Tracer::BvhBundles, test::Tracer::BvhSingle, test::Tracer::Octree),
                          [](const auto& p) { return std::string(test::tracer_name(p.param)); });

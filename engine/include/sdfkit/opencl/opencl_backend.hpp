@@ -58,10 +58,11 @@ struct OpenClConfig {
   int octree_leaf_size = 8;
   // BVH: the triangle count under which the SAH may stop splitting.
   int bvh_leaf_size = 4;
-  // BVH: trace 8 rays of a point together as one vector packet per work item (SIMD on CPU
-  // devices) instead of one ray per work item. Unset: packets on CPU devices, single rays on
-  // GPUs (whose work items are scalar lanes already).
-  std::optional<bool> bvh_packets;
+  // BVH: trace ray r of 16 neighbouring points (Morton order) together as one float16 bundle
+  // per work item (SIMD on CPU devices: nearly parallel rays from nearby origins, every lane
+  // busy) instead of one ray per work item. Unset: bundles on CPU devices, single rays on GPUs
+  // (whose work items are scalar lanes already).
+  std::optional<bool> bvh_bundles;
   // Work-group size of the trace and gather kernels; 0 = 32 on CPU devices (measured: the
   // driver's choice left a core idle at the end of small launches), the driver's on GPUs.
   std::size_t work_group_size = 0;
