@@ -17,8 +17,9 @@ namespace {
 
 constexpr int kBins = 16;
 constexpr int kMedianBelowDepth = 40;
-// Meshes with at least this many triangles build the root's two subtrees concurrently.
-constexpr std::size_t kParallelBelow = 16384;
+// Meshes with at least this many triangles build the root's two subtrees concurrently (a thread
+// costs ~0.1 ms; elephant, 5.5k triangles: 2.7 -> 2.0 ms per build).
+constexpr std::size_t kParallelBelow = 1024;
 
 struct Box {
   glm::vec3 lo{std::numeric_limits<float>::max()};
