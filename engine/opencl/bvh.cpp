@@ -78,14 +78,17 @@ struct Builder {
       // Binned SAH over the three axes, binned in one pass over the triangles.
       std::array<std::array<Box, kBins>, 3> bin_box{};
       std::array<std::array<std::size_t, kBins>, 3> bin_count{};
+      // As many bins as triangles up to kBins: a small node's sweep over empty bins costs more
+      // than its binning (most nodes are small).
+      const int bins = static_cast<int>(std::min<std::size_t>(kBins, std::max<std::size_t>(n, 2)));
       glm::vec3 scale(0.0f);
       for (int axis = 0; axis < 3; ++axis)
-        if (extent[axis] > 0.0f) scale[axis] = kBins / extent[axis];
+        if (extent[axis] > 0.0f) scale[axis] = static_cast<float>(bins) / extent[axis];
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t f = items[i];
         const glm::vec3 rel = (centroid[f] - cbounds.lo) * scale;
         for (int axis = 0; axis < 3; ++axis) {
-          const auto b = static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(rel[axis])));
+          const auto b = static_cast<std::size_t>(std::min(bins - 1, static_cast<int>(rel[axis])));
           bin_box[static_cast<std::size_t>(axis)][b].grow(boxes[f]);
           ++bin_count[static_cast<std::size_t>(axis)][b];
         }
@@ -99,14 +102,14 @@ struct Builder {
         std::array<float, kBins> right_cost{};
         Box acc;
         std::size_t count = 0;
-        for (int b = kBins - 1; b > 0; --b) {
+        for (int b = bins - 1; b > 0; --b) {
           acc.grow(bb[static_cast<std::size_t>(b)]);
           count += bc[static_cast<std::size_t>(b)];
           right_cost[static_cast<std::size_t>(b)] = acc.half_area() * static_cast<float>(count);
         }
         acc = Box{};
         count = 0;
-        for (int b = 0; b < kBins - 1; ++b) {
+        for (int b = 0; b < bins - 1; ++b) {
           acc.grow(bb[static_cast<std::size_t>(b)]);
           count += bc[static_cast<std::size_t>(b)];
           const float cost = acc.half_area() * static_cast<float>(count) + right_cost[static_cast<std::size_t>(b) + 1];
@@ -126,7 +129,7 @@ struct Builder {
         const auto it = std::partition(items.begin() + static_cast<std::ptrdiff_t>(begin),
                                        items.begin() + static_cast<std::ptrdiff_t>(end),
                                        [&](std::uint32_t f) {
-                                         return std::min(kBins - 1, static_cast<int>((centroid[f][best_axis] - lo) * sc)) <= best_split;
+                                         return std::min(bins - 1, static_cast<int>((centroid[f][best_axis] - lo) * sc)) <= best_split;
                                        });
         mid = static_cast<std::size_t>(it - items.begin());
       }
