@@ -83,7 +83,7 @@ void add_skeleton_command(CLI::App& app) {
     } else if (ext == ".obj") {
       io::write_file_atomically(a->output, [&](std::ostream& os) { skeleton::write_obj(os, skel); });
     } else {
-      SdfField field;  // the input's SDF, computed by extract() on its first iteration
+      SdfField field;  // the input's SDF, measured by extract()
       field.domain = SdfDomain::Vertex;
       field.values = skel.sdf;
       io::WriteOptions write = a->sdf.write;

@@ -46,9 +46,13 @@ bool all_finite(const Eigen::MatrixXd& m) { return m.allFinite(); }
 
 }  // namespace
 
-ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& options) {
+ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& options,
+                           std::span<const float> first_sdf) {
   validate(options);
   detail::require_closed(mesh, "skeleton extraction");
+  if (!first_sdf.empty() && first_sdf.size() != mesh.positions.size())
+    throw InputError("contract() got " + std::to_string(first_sdf.size()) + " first SDF values for " +
+                     std::to_string(mesh.positions.size()) + " vertices");
   ContractionResult result;
   result.contracted = mesh;
   const bool use_sdf = options.sdf_term && backend != nullptr;
@@ -64,7 +68,7 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
   double wl = options.wl_scale * (diag * diag) / mean_face_area;
   std::vector<double> wh(n, options.wh0);
 
-  if (use_sdf) backend->set_mesh(mesh);
+  bool backend_has_mesh = false;  // set_mesh at the first measurement, update_positions after
   Eigen::MatrixXd V(static_cast<Eigen::Index>(n), 3);
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) V(static_cast<Eigen::Index>(i), k) = mesh.positions[i][k];
@@ -82,22 +86,29 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
     const auto t_sdf = Clock::now();
     Eigen::MatrixXd C;
     if (use_sdf) {
-      if (it > 0) backend->update_positions(current.positions);
-      // The first SDF at full quality (holding weights, Skeleton::sdf), the later ones with
-      // iteration_rays: the centering term needs only an approximate thickness.
-      sdf_options.rays = it > 0 && options.iteration_rays > 0 ? options.iteration_rays : options.sdf.rays;
-      const SdfField field = compute_sdf(*backend, current, sdf_options);
-      if (it == 0) {
-        result.first_sdf = field.values;
-        thickness = field.values;
+      // The first SDF at full quality (holding weights, Skeleton::sdf) unless given, the later
+      // ones with iteration_rays: the centering term needs only an approximate thickness.
+      std::vector<float> values;
+      if (it == 0 && !first_sdf.empty()) {
+        values.assign(first_sdf.begin(), first_sdf.end());
+      } else {
+        if (!backend_has_mesh) backend->set_mesh(current);
+        else backend->update_positions(current.positions);
+        backend_has_mesh = true;
+        sdf_options.rays = it > 0 && options.iteration_rays > 0 ? options.iteration_rays : options.sdf.rays;
+        values = compute_sdf(*backend, current, sdf_options).values;
       }
-      result.last_sdf = field.values;
+      if (it == 0) {
+        result.first_sdf = values;
+        thickness = values;
+      }
       // Contraction only thins the shape, so a vertex's SDF never grows: on the crumpled,
       // partly collapsed mesh of later iterations some rays escape through folds and measure
       // far surfaces; those values would pull vertices outward (C_i) and, through the
       // normalization, make every other vertex look thin and hold it (measured on CGAL's
       // elephant: the area grew from 0.28 to 0.40 of the original over five iterations).
-      for (std::size_t i = 0; i < n; ++i) thickness[i] = std::min(thickness[i], field.values[i]);
+      for (std::size_t i = 0; i < n; ++i) thickness[i] = std::min(thickness[i], values[i]);
+      result.last_sdf = std::move(values);
       const std::vector<glm::vec3> normals = vertex_normals(current);
       C = V;
       for (std::size_t i = 0; i < n; ++i)

@@ -513,18 +513,35 @@ Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions
               std::to_string(proxy.collapses) + " collapses, " + std::to_string(proxy.refused) +
               " refused) in " + std::to_string(1e3 * seconds.simplify) + " ms");
   }
+  // The input's own SDF at full quality (radii, centre points, grouping, Skeleton::sdf). With a
+  // proxy it is measured first, and each proxy vertex starts the contraction from the mean over
+  // the input vertices merged into it (the proxy stands for the input's surface; one SDF at full
+  // quality instead of two). Without a proxy it is the contraction's first SDF.
+  std::vector<float> sdf, proxy_first_sdf;
+  if (use_proxy && backend != nullptr) {
+    t = Clock::now();
+    backend->set_mesh(mesh);
+    sdf = compute_sdf(*backend, mesh, so).values;
+    seconds.input_sdf = seconds_since(t);
+    if (contraction.sdf_term) {
+      proxy_first_sdf.assign(proxy.mesh.positions.size(), 0.0f);
+      std::vector<std::uint32_t> count(proxy.mesh.positions.size(), 0);
+      for (std::size_t k = 0; k < proxy.vertex_map.size(); ++k) {
+        proxy_first_sdf[proxy.vertex_map[k]] += sdf[k];
+        ++count[proxy.vertex_map[k]];
+      }
+      for (std::size_t p = 0; p < count.size(); ++p)
+        if (count[p] > 0) proxy_first_sdf[p] /= static_cast<float>(count[p]);
+    }
+  }
   t = Clock::now();
-  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, contraction);
+  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, contraction, proxy_first_sdf);
   seconds.contraction = seconds_since(t);
   seconds.contraction_sdf = c.sdf_seconds;
   seconds.contraction_solve = c.solve_seconds;
-
-  // The input's own SDF at full quality (radii, centre points, grouping, Skeleton::sdf): the
-  // first SDF of the contraction, else measured once here.
-  t = Clock::now();
-  std::vector<float> sdf;
   if (!use_proxy) sdf = std::move(c.first_sdf);
-  if (backend != nullptr && sdf.empty()) {
+  if (backend != nullptr && sdf.empty()) {  // the plain contraction measured no SDF
+    t = Clock::now();
     backend->set_mesh(mesh);
     sdf = compute_sdf(*backend, mesh, so).values;
     seconds.input_sdf = seconds_since(t);

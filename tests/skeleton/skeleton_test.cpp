@@ -367,11 +367,14 @@ TEST(Skeleton, FineCapsuleGoesThroughTheProxyAndKeepsItsProperties) {
   const sk::Skeleton s = sk::extract(mesh, &backend, co, {});
   EXPECT_LE(s.contracted_vertices, co.proxy_vertices);
   EXPECT_GT(s.contracted_vertices, co.proxy_vertices / 2);
-  // The proxy is contracted, then the input's SDF is measured once.
+  // The input's SDF is measured once at full quality, then the proxy is contracted from the
+  // input's values (no second full-quality SDF) with iteration_rays at every later iteration.
   ASSERT_EQ(backend.vertices.size(), 2u);
-  EXPECT_EQ(backend.vertices[0], s.contracted_vertices);
-  EXPECT_EQ(backend.vertices[1], mesh.positions.size());
-  EXPECT_EQ(backend.rays.back(), co.sdf.rays);
+  EXPECT_EQ(backend.vertices[0], mesh.positions.size());
+  EXPECT_EQ(backend.vertices[1], s.contracted_vertices);
+  ASSERT_EQ(backend.rays.size(), static_cast<std::size_t>(s.iterations));
+  EXPECT_EQ(backend.rays.front(), co.sdf.rays);
+  for (std::size_t k = 1; k < backend.rays.size(); ++k) EXPECT_EQ(backend.rays[k], co.iteration_rays);
   ASSERT_EQ(s.sdf.size(), mesh.positions.size());
   std::vector<float> sdf = s.sdf;
   std::nth_element(sdf.begin(), sdf.begin() + sdf.size() / 2, sdf.end());

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <span>
 #include <vector>
 
 namespace sdfkit::skeleton {
@@ -77,14 +78,17 @@ struct ContractionOptions {
   double area_ratio_stop = 1e-3;
   int max_iterations = 20;  // hard cap on the iterations (>= 1)
   // Options of the SDF (domain: Vertex). The first iteration measures it with sdf.rays (that
-  // SDF normalizes the holding weights and, without a proxy, is Skeleton::sdf) ...
+  // SDF normalizes the holding weights and, without a proxy, is Skeleton::sdf; through a proxy
+  // extract() measures the input's SDF and the proxy starts from its per-vertex means) ...
   SdfOptions sdf;
   // ... and every later iteration recomputes it on the current mesh with this many rays
   // (0 = sdf.rays): the centering term needs only an approximate thickness, and takes the
   // smallest value measured so far, mostly the first. Measured on the star (3888 vertices):
   // the contracted vertices' mean distance to the medial axis is 0.0423 / 0.0423 / 0.0422 /
-  // 0.0422 with 4 / 8 / 16 / 30 rays; the SDF is 60-70 % of an iteration at 30 rays.
-  int iteration_rays = 8;
+  // 0.0422 with 4 / 8 / 16 / 30 rays; the SDF is 60-70 % of an iteration at 30 rays. 4 rays
+  // against 8 through the proxy: curve reliability about the same on CGAL's hand, elephant and
+  // camel, hand's contraction SDF 19 ms instead of 25 (engine/skeleton/README.md).
+  int iteration_rays = 4;
   // extract(): a mesh with more vertices than this is contracted through a proxy simplified to
   // this many vertices (manifold-preserving quadric edge collapses that keep closedness and
   // genus); every input vertex follows the proxy vertex it was merged into, and the skeleton
@@ -116,7 +120,11 @@ struct ContractionResult {
 // constraints. `backend` may be nullptr: then no SDF term (the plain Au et al. contraction).
 // Never returns NaN positions: a failing factorization or a non-finite solution stops the loop
 // with the last good state and a warning. Throws InputError for unusable input (see top).
-ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& options);
+// `first_sdf`: the per-vertex SDF of `mesh` as given when the caller has it already (the first
+// iteration then uses it instead of measuring it with options.sdf.rays; extract() passes the
+// input's SDF averaged over the input vertices of each proxy vertex); empty = measure it.
+ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& options,
+                           std::span<const float> first_sdf = {});
 
 struct SkeletonOptions {
   double ggt = 0.05;   // grouping: global part of the distance, fraction of the bbox diagonal
