@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <string>
+#include <limits>
 #include <map>
 #include <queue>
 
@@ -202,35 +203,39 @@ struct Candidate {
   }
 };
 
-// Cheapest-first half-edge collapses while triangles remain. A queue entry is valid while its
-// cost equals the half-edge's current cost; after collapsing i -> j, fresh entries are pushed
-// for every half-edge whose cost changed: those out of j, those into j, and those out of i's
-// former neighbours (their sampling cost's edge lengths changed).
+// Cheapest-first half-edge collapses while triangles remain: the cheapest collapse out of each
+// vertex (ties: the lower target), the cheapest over all vertices first (ties: the lower
+// source), i.e. the half-edge order (cost, from, to). The queue holds one entry per vertex,
+// valid while the vertex's stamp is unchanged; after collapsing i -> j, j and every neighbour
+// of j (i's former neighbours among them) get a fresh entry: their out-costs changed through
+// Q_j, the moved edges, or the sampling cost's edge lengths. (One entry per half-edge with
+// stale entries dropped at pop time made the same collapses with a far larger queue: CGAL's
+// hand, 991 collapses, 6.6 ms then, 4.3 ms now.)
 void remove_all_faces(Complex& c, const SurgeryOptions& o, std::size_t& collapses) {
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> queue;
-  auto push = [&](std::uint32_t i, std::uint32_t j, double around) {
-    queue.push({c.cost(i, j, around, o.shape_weight, o.sampling_weight), i, j, 0});
-  };
-  auto push_out = [&](std::uint32_t i) {
+  auto push_best = [&](std::uint32_t i) {
+    c.bump(i);
     const double around = c.around(i);
-    for (std::uint32_t j : c.face_neighbours(i)) push(i, j, around);
+    Candidate best{std::numeric_limits<double>::infinity(), i, i, c.stamp(i)};
+    for (std::uint32_t j : c.face_neighbours(i)) {
+      const double cost = c.cost(i, j, around, o.shape_weight, o.sampling_weight);
+      if (cost < best.cost || (cost == best.cost && j < best.to)) best.cost = cost, best.to = j;
+    }
+    if (best.to != i) queue.push(best);
   };
-  for (std::uint32_t i = 0; i < c.size(); ++i) push_out(i);
-  std::vector<std::uint32_t> former;
+  for (std::uint32_t i = 0; i < c.size(); ++i) push_best(i);
   while (c.alive_faces() > 0 && !queue.empty()) {
     const Candidate e = queue.top();
     queue.pop();
-    if (!c.alive(e.from) || !c.alive(e.to) || !c.edge_on_face(e.from, e.to)) continue;
-    if (c.cost(e.from, e.to, c.around(e.from), o.shape_weight, o.sampling_weight) != e.cost)
-      continue;  // stale: a fresh entry with the current cost is in the queue
-    former = c.neighbours(e.from);
+    if (!c.alive(e.from) || e.stamp != c.stamp(e.from)) continue;  // stale
+    if (!c.alive(e.to) || !c.edge_on_face(e.from, e.to)) {
+      push_best(e.from);
+      continue;
+    }
     c.collapse(e.from, e.to);
     ++collapses;
-    push_out(e.to);
-    for (std::uint32_t k : c.neighbours(e.to))
-      if (c.edge_on_face(k, e.to)) push(k, e.to, c.around(k));
-    for (std::uint32_t k : former)
-      if (k != e.to && c.alive(k)) push_out(k);
+    push_best(e.to);
+    for (std::uint32_t k : c.neighbours(e.to)) push_best(k);
   }
 }
 
