@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <numeric>
 
 namespace sdfkit::skeleton {
@@ -83,6 +84,12 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
   };
   for (int it = 0; it < options.max_iterations; ++it) {
     Mesh& current = result.contracted;
+    // The Laplacian term depends only on the current positions and W_L: it is assembled on a
+    // second thread while the SDF is measured (the host mostly waits for the device there).
+    auto laplacian_term = std::async(std::launch::async, [&current, wl] {
+      const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(current);
+      return Eigen::SparseMatrix<double>((wl * wl) * (L * L));  // L is symmetric: L^T L = L L
+    });
     const auto t_sdf = Clock::now();
     Eigen::MatrixXd C;
     if (use_sdf) {
@@ -125,8 +132,7 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
     const double sdf_ms = ms_since(t_sdf);
     result.sdf_seconds += 1e-3 * sdf_ms;
     const auto t_solve = Clock::now();
-    const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(current);
-    Eigen::SparseMatrix<double> A = (wl * wl) * (L * L);  // L is symmetric: L^T L = L L
+    Eigen::SparseMatrix<double> A = laplacian_term.get();
     Eigen::VectorXd diagonal(static_cast<Eigen::Index>(n));
     Eigen::MatrixXd rhs(static_cast<Eigen::Index>(n), 3);
     const double wc2 = use_sdf ? options.wc * options.wc : 0.0;
