@@ -218,6 +218,15 @@ struct Builder {
   }
 };
 
+// Pad every triangle's box by a millionth of the mesh's largest coordinate: the device's slab
+// tests and its triangle tests round differently, and a box shaved by rounding (a flat box
+// of an axis-aligned face, a hit on a box's edge) would hide a hit the triangle test finds.
+glm::vec3 box_padding(const std::vector<Box>& boxes, const std::vector<std::uint32_t>& faces) {
+  float largest = 0.0f;
+  for (std::uint32_t f : faces) largest = std::max({largest, glm::length(boxes[f].lo), glm::length(boxes[f].hi)});
+  return glm::vec3(1e-6f * largest + std::numeric_limits<float>::min());
+}
+
 }  // namespace
 
 Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
@@ -233,17 +242,53 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     b.centroid[f] = (b.boxes[f].lo + b.boxes[f].hi) * 0.5f;
     b.items.push_back(f);
   }
-  // Pad every triangle's box by a millionth of the mesh's largest coordinate: the device's slab
-  // tests and its triangle tests round differently, and a box shaved by rounding (a flat box
-  // of an axis-aligned face, a hit on a box's edge) would hide a hit the triangle test finds.
-  float largest = 0.0f;
-  for (std::uint32_t f : b.items) largest = std::max({largest, glm::length(b.boxes[f].lo), glm::length(b.boxes[f].hi)});
-  const glm::vec3 pad(1e-6f * largest + std::numeric_limits<float>::min());
+  const glm::vec3 pad = box_padding(b.boxes, b.items);
   for (std::uint32_t f : b.items) {
     b.boxes[f].lo -= pad;
     b.boxes[f].hi += pad;
   }
   return b.build_all();
+}
+
+bool refit_bvh(Bvh& bvh, const Mesh& mesh) {
+  const auto degenerate = degenerate_faces(mesh);
+  std::vector<std::uint8_t> in_tree(mesh.triangles.size(), 0);
+  for (std::uint32_t f : bvh.order) in_tree[f] = 1;
+  for (std::size_t f = 0; f < in_tree.size(); ++f)
+    if (!in_tree[f] && !degenerate[f]) return false;
+  std::vector<Box> boxes(mesh.triangles.size());
+  for (std::uint32_t f : bvh.order)
+    for (std::uint32_t v : mesh.triangles[f]) boxes[f].grow(mesh.positions[v]);
+  const glm::vec3 pad = box_padding(boxes, bvh.order);
+  // Children follow their parent in the depth-first layout: a reverse sweep visits them first.
+  std::vector<Box> node_box(bvh.nodes.size());
+  for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
+    BvhNode& node = bvh.nodes[i];
+    Box b;
+    if (node.is_leaf()) {
+      for (std::uint32_t k = node.first_or_second; k < node.first_or_second + node.triangles(); ++k)
+        b.grow(boxes[bvh.order[k]]);
+      if (!b.empty()) b.lo -= pad, b.hi += pad;
+    } else {
+      b.grow(node_box[i + 1]);
+      b.grow(node_box[node.first_or_second]);
+    }
+    node_box[i] = b;
+    Builder::set_bounds(node, b);
+  }
+  return true;
+}
+
+double sah_cost(const Bvh& bvh) {
+  if (bvh.nodes.empty()) return 0.0;
+  const auto area = [](const BvhNode& n) {
+    const glm::dvec3 e = glm::dvec3(n.max) - glm::dvec3(n.min);
+    return e.x * e.y + e.y * e.z + e.z * e.x;
+  };
+  double sum = 0.0;
+  for (const BvhNode& n : bvh.nodes) sum += area(n) * (n.is_leaf() ? n.triangles() : 1.0);
+  const double root = area(bvh.nodes[0]);
+  return root > 0.0 ? sum / root : 0.0;
 }
 
 }  // namespace sdfkit::cl

@@ -96,9 +96,10 @@ void set_args(cl_kernel kernel, const char* kernel_name, const Args&... args) {
 
 // Work-group size on CPU devices when the configuration leaves it open: PoCL's own choice left
 // one of two cores idle at the end of small launches (elephant, 2775 points x 25 rays: 20-23 ms
-// of trace and gather against 14-15 ms with 16-64; CGAL's hand at 8 rays: 5.6 ms against 2.6 ms;
-// armadillo per face: 2-5 % less).
-constexpr std::size_t kCpuWorkGroup = 32;
+// of trace and gather against 14-15 ms with 16-64, then with one point's packet per work item).
+// A bundle work item traces 16 rays, so groups of 8: CGAL's hand at 4 rays (the skeleton's
+// contraction calls) 1.5 -> 0.8 ms, elephant 3.6 -> 1.9 ms; at 30 rays no change.
+constexpr std::size_t kCpuWorkGroup = 8;
 // Points per work item of trace_bundles (BUNDLE in cl/sdf_trace.cl).
 constexpr std::size_t kBundle = 16;
 
@@ -162,6 +163,8 @@ struct OpenClBackend::Impl {
   bool has_mesh = false;
   Octree octree;
   Bvh bvh;
+  double built_sah = 0.0;  // sah_cost of the last full build
+  bool refitted = false;   // the last geometry update refit the BVH instead of building it
   detail::Buffer nodes, cells, tris;
   std::size_t geometry_bytes = 0;
 
@@ -177,7 +180,7 @@ struct OpenClBackend::Impl {
   void create(const OpenClConfig& cfg);
   void build_program();
   detail::Kernel make_kernel(const char* name);
-  void rebuild_geometry();
+  void rebuild_geometry(bool positions_moved);
   void ensure_table(int rays, float cone_degrees);
   void write(cl_mem buffer, std::size_t bytes, const void* data, const char* what);
   void run(cl_kernel kernel, std::size_t items, std::size_t local, const char* name);
@@ -187,6 +190,8 @@ struct OpenClBackend::Impl {
 void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
   config = cfg;
   if (cfg.memory_cap == 0) throw InputError("the OpenCL memory cap must be positive");
+  if (!(cfg.bvh_refit_limit >= 0.0) || !std::isfinite(cfg.bvh_refit_limit))
+    throw InputError("the BVH refit limit must be a finite number >= 0");
   const auto devices = detail::enumerate_devices();
   const std::size_t index = select_device(devices, cfg.device);
   const detail::FoundDevice& d = devices[index];
@@ -269,12 +274,22 @@ void OpenClBackend::Impl::run(cl_kernel kernel, std::size_t items, std::size_t l
 
 // Host: builds the octree and the per-face records; device: uploads them into buffers that
 // only grow, so moving vertices reuses the allocations.
-void OpenClBackend::Impl::rebuild_geometry() {
+void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
   auto start = std::chrono::steady_clock::now();
   // The triangle list of the leaves, leaf by leaf (octree: a triangle once per leaf it touches).
   const std::vector<std::uint32_t>* order = nullptr;
+  refitted = false;
   if (config.accel == Accel::Bvh) {
-    bvh = build_bvh(mesh, BvhParams{config.bvh_leaf_size});
+    // After update_positions: refit while the tree stays nearly as good as a fresh build.
+    if (positions_moved && config.bvh_refit_limit > 0.0 && !bvh.nodes.empty()) {
+      Bvh candidate = bvh;
+      refitted = refit_bvh(candidate, mesh) && sah_cost(candidate) <= config.bvh_refit_limit * built_sah;
+      if (refitted) bvh = std::move(candidate);
+    }
+    if (!refitted) {
+      bvh = build_bvh(mesh, BvhParams{config.bvh_leaf_size});
+      built_sah = sah_cost(bvh);
+    }
     order = &bvh.order;
   } else {
     octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
@@ -349,7 +364,7 @@ void OpenClBackend::set_mesh(const Mesh& mesh) {
   validate_mesh(mesh, "the mesh given to the OpenCL backend");
   impl_->mesh = mesh;
   impl_->has_mesh = true;
-  impl_->rebuild_geometry();
+  impl_->rebuild_geometry(false);
 }
 
 void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
@@ -362,7 +377,7 @@ void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw InputError("update_positions got a non-finite coordinate");
   impl_->mesh.positions.assign(positions.begin(), positions.end());
-  impl_->rebuild_geometry();
+  impl_->rebuild_geometry(true);
 }
 
 std::size_t OpenClBackend::batch_points(int rays) const {
@@ -460,7 +475,10 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
 }
 
 std::vector<StageTiming> OpenClBackend::last_timings() const {
-  return {{impl_->config.accel == Accel::Bvh ? "bvh_build" : "octree_build", impl_->octree_ms},
+  const char* build = impl_->config.accel == Accel::Octree ? "octree_build"
+                      : impl_->refitted                   ? "bvh_refit"
+                                                          : "bvh_build";
+  return {{build, impl_->octree_ms},
           {"upload", impl_->upload_ms},
           {"trace_gather", impl_->trace_ms}};
 }

@@ -127,11 +127,8 @@ TEST(Octree, RejectsBadParameters) {
 // The BVH: every non-degenerate triangle in exactly one leaf, boxes nest and contain their
 // triangles, depth within the device stack. A small mesh (built on one thread) and one large
 // enough for the root's subtrees to be built on two threads and spliced.
-void expect_valid_bvh(Mesh mesh) {
-  using sdfkit::cl::Bvh;
+void expect_valid_bvh(const sdfkit::cl::Bvh& b, const Mesh& mesh) {
   using sdfkit::cl::BvhNode;
-  mesh.triangles.push_back({0, 0, 1});  // degenerate
-  const Bvh b = sdfkit::cl::build_bvh(mesh, {4});
   const auto degenerate = degenerate_faces(mesh);
   std::vector<int> seen(mesh.triangles.size(), 0);
   std::vector<std::pair<std::uint32_t, int>> todo{{0, 0}};
@@ -166,7 +163,49 @@ void expect_valid_bvh(Mesh mesh) {
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) EXPECT_EQ(seen[f], degenerate[f] ? 0 : 1) << f;
 }
 
+Mesh with_degenerate(Mesh mesh) {
+  mesh.triangles.push_back({0, 0, 1});
+  return mesh;
+}
+
 TEST(Bvh, LeavesPartitionTheTrianglesAndBoxesNest) {
-  expect_valid_bvh(shapes::torus(2.0f, 0.6f, 48, 24));    // 2304 triangles
-  expect_valid_bvh(shapes::torus(2.0f, 0.6f, 192, 96));  // 36864 triangles: two threads
+  for (const Mesh& m : {with_degenerate(shapes::torus(2.0f, 0.6f, 48, 24)),      // 2304 triangles
+                        with_degenerate(shapes::torus(2.0f, 0.6f, 192, 96))}) {  // two threads
+    expect_valid_bvh(sdfkit::cl::build_bvh(m, {4}), m);
+  }
+}
+
+// A refit keeps the tree and the triangle order, and its boxes again nest and contain the
+// moved triangles; its SAH cost is that of the same tree over the new boxes (a fresh build of
+// the moved mesh is no worse).
+TEST(Bvh, RefitBoxesContainTheMovedTriangles) {
+  const Mesh before = with_degenerate(shapes::torus(2.0f, 0.6f, 48, 24));
+  Mesh after = before;
+  for (glm::vec3& p : after.positions) p = glm::vec3(p.x * 0.5f, p.y + 0.3f * p.x * p.x, p.z * 2.0f);
+  sdfkit::cl::Bvh b = sdfkit::cl::build_bvh(before, {4});
+  const auto order = b.order;
+  const double built = sdfkit::cl::sah_cost(b);
+  ASSERT_TRUE(sdfkit::cl::refit_bvh(b, after));
+  EXPECT_EQ(b.order, order);
+  expect_valid_bvh(b, after);
+  EXPECT_GT(sdfkit::cl::sah_cost(b), 0.0);
+  EXPECT_LE(sdfkit::cl::sah_cost(sdfkit::cl::build_bvh(after, {4})), 1.01 * sdfkit::cl::sah_cost(b));
+  // Refitting to the build's own positions gives the build's boxes.
+  ASSERT_TRUE(sdfkit::cl::refit_bvh(b, before));
+  EXPECT_NEAR(sdfkit::cl::sah_cost(b), built, 1e-9 * built);
+}
+
+// A triangle left out as degenerate that gets an area cannot be refit into the tree.
+TEST(Bvh, RefitRefusesATriangleThatIsNoLongerDegenerate) {
+  Mesh mesh = shapes::torus(2.0f, 0.6f, 24, 12);
+  const auto n = static_cast<std::uint32_t>(mesh.positions.size());
+  mesh.positions.push_back({0, 0, 0});
+  mesh.positions.push_back({1, 0, 0});
+  mesh.positions.push_back({2, 0, 0});  // collinear: degenerate
+  mesh.triangles.push_back({n, n + 1, n + 2});
+  sdfkit::cl::Bvh b = sdfkit::cl::build_bvh(mesh, {4});
+  Mesh moved = mesh;
+  EXPECT_TRUE(sdfkit::cl::refit_bvh(b, moved));
+  moved.positions[n + 1].y = 1.0f;
+  EXPECT_FALSE(sdfkit::cl::refit_bvh(b, moved));
 }

@@ -148,6 +148,45 @@ TEST_P(OpenClUpdate, UpdatePositionsEqualsFreshSetMesh) {
   EXPECT_THROW(backend.update_positions(std::vector<glm::vec3>(3)), Error);
 }
 
+// update_positions refits the BVH for a small move, rebuilds it for a distortion that would
+// leave a refit tree much worse than a new one, and rebuilds when a degenerate triangle gets an
+// area; every way gives the values of a fresh set_mesh.
+TEST(OpenClUpdate, RefitsSmallMovesAndRebuildsLargeOnes) {
+  SDFKIT_REQUIRE_CL_ACCEL(backend, test::Tracer::BvhBundles);
+  Mesh base = shapes::capsule(1.0f, 3.0f, 40, 20);
+  const auto n = static_cast<std::uint32_t>(base.positions.size());
+  base.positions.push_back({0.0f, 0.0f, 0.0f});  // a degenerate triangle inside
+  base.positions.push_back({0.1f, 0.0f, 0.0f});
+  base.positions.push_back({0.2f, 0.0f, 0.0f});
+  base.triangles.push_back({n, n + 1, n + 2});
+  auto moved = [&](auto f) {
+    Mesh m = base;
+    for (std::size_t i = 0; i < n; ++i) m.positions[i] = f(m.positions[i]);
+    return m;
+  };
+  const Mesh nudged = moved([](glm::vec3 p) { return p * 1.02f + glm::vec3(0.01f * p.z, 0, 0); });
+  // Folds the capsule onto itself: parts far apart in the tree now overlap.
+  const Mesh folded = moved([](glm::vec3 p) { return glm::vec3(p.x, p.y, std::sin(6.0f * p.z)); });
+  const Mesh opened = [&] {
+    Mesh m = base;
+    m.positions[n + 1].y = 0.1f;
+    return m;
+  }();
+  SdfOptions o;
+  for (const auto& [mesh, stage] : {std::pair{&nudged, "bvh_refit"}, std::pair{&folded, "bvh_build"},
+                                    std::pair{&opened, "bvh_build"}}) {
+    backend.set_mesh(base);
+    backend.update_positions(mesh->positions);
+    EXPECT_EQ(backend.last_timings().front().stage, stage);
+    const RawSdf updated = backend.compute(make_query(*mesh, SdfDomain::Vertex), o);
+    backend.set_mesh(*mesh);
+    EXPECT_EQ(backend.last_timings().front().stage, "bvh_build");
+    const RawSdf fresh = backend.compute(make_query(*mesh, SdfDomain::Vertex), o);
+    EXPECT_EQ(updated.values, fresh.values) << stage;
+    EXPECT_EQ(updated.kept_rays, fresh.kept_rays) << stage;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Tracer, OpenClUpdate, ::testing::Values(test::Tracer::BvhBundles, test::Tracer::BvhSingle, test::Tracer::Octree),
                          [](const auto& p) { return std::string(test::tracer_name(p.param)); });
 

@@ -50,4 +50,16 @@ struct Bvh {
 // Throws InputError for params out of range.
 Bvh build_bvh(const Mesh& mesh, const BvhParams& params);
 
+// Recomputes every box of `bvh` (built for a mesh with the same triangles) from the mesh's
+// current positions, bottom-up, keeping the tree and the triangle order; padding as in a
+// build. Returns false, leaving `bvh` unusable, when a triangle that the build left out as
+// degenerate is not degenerate any more (the tree lacks it): rebuild then.
+bool refit_bvh(Bvh& bvh, const Mesh& mesh);
+
+// The tree's surface-area cost relative to its root box: the sum over internal nodes of their
+// box area plus, over leaves, box area times triangle count, divided by the root's area (the
+// expected box and triangle tests of a ray through the root). A refit tree whose cost has grown
+// well past its build's has boxes that overlap more and more: rebuild it.
+double sah_cost(const Bvh& bvh);
+
 }  // namespace sdfkit::cl

@@ -58,6 +58,11 @@ struct OpenClConfig {
   int octree_leaf_size = 8;
   // BVH: the triangle count under which the SAH may stop splitting.
   int bvh_leaf_size = 4;
+  // BVH: update_positions refits the tree (new boxes, same tree: O(n) instead of a build) while
+  // its SAH cost stays within this factor of the last full build's; past it, or when a triangle
+  // that was degenerate at the build is not any more, it rebuilds. 0 = always rebuild. The
+  // skeleton's contraction moves vertices every iteration: measured in engine/opencl/README.md.
+  double bvh_refit_limit = 1.25;
   // BVH: trace ray r of 16 neighbouring points (Morton order) together as one float16 bundle
   // per work item (SIMD on CPU devices: nearly parallel rays from nearby origins, every lane
   // busy) instead of one ray per work item. Unset: bundles on CPU devices, single rays on GPUs
@@ -81,7 +86,7 @@ public:
   void set_mesh(const Mesh& mesh) override;
   void update_positions(std::span<const glm::vec3> positions) override;
   RawSdf compute(const SdfQuery& query, const SdfOptions& options) override;
-  // "octree_build" (or "bvh_build") and "upload" of the last set_mesh/update_positions,
+  // "octree_build" (or "bvh_build", "bvh_refit") and "upload" of the last set_mesh/update_positions,
   // "trace_gather" of the last compute (milliseconds, wall clock, including the queue's
   // completion).
   std::vector<StageTiming> last_timings() const override;
