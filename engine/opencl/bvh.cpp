@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <future>
 #include <limits>
 #include <string>
@@ -122,7 +123,7 @@ struct Builder {
       }
       // SAH: a split costs one traversal step plus its children's expected triangle tests.
       const float leaf_cost = static_cast<float>(n);
-      const float split_cost = 1.0f + best_cost / std::max(s.bounds.half_area(), 1e-30f);
+      const float split_cost = params.traversal_cost + best_cost / std::max(s.bounds.half_area(), 1e-30f);
       if (n <= static_cast<std::size_t>(params.leaf_size) && (best_axis < 0 || split_cost >= leaf_cost)) return s;
       if (best_axis >= 0) {
         const float sc = scale[best_axis], lo = cbounds.lo[best_axis];
@@ -232,6 +233,8 @@ glm::vec3 box_padding(const std::vector<Box>& boxes, const std::vector<std::uint
 Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
   if (params.leaf_size < 1)
     throw InputError("the BVH leaf size must be at least 1, got " + std::to_string(params.leaf_size));
+  if (!(params.traversal_cost > 0.0f) || !std::isfinite(params.traversal_cost))
+    throw InputError("the BVH traversal cost must be positive, got " + std::to_string(params.traversal_cost));
   Builder b{params, {}, {}, {}};
   const auto degenerate = degenerate_faces(mesh);
   b.boxes.resize(mesh.triangles.size());

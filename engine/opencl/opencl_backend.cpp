@@ -190,6 +190,8 @@ struct OpenClBackend::Impl {
 void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
   config = cfg;
   if (cfg.memory_cap == 0) throw InputError("the OpenCL memory cap must be positive");
+  if (cfg.bvh_leaf_size < 0 || !(cfg.bvh_traversal_cost >= 0.0f) || !std::isfinite(cfg.bvh_traversal_cost))
+    throw InputError("the BVH leaf size and traversal cost must be >= 0 (0 = the tracer's default)");
   if (!(cfg.bvh_refit_limit >= 0.0) || !std::isfinite(cfg.bvh_refit_limit))
     throw InputError("the BVH refit limit must be a finite number >= 0");
   const auto devices = detail::enumerate_devices();
@@ -287,7 +289,10 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
       if (refitted) bvh = std::move(candidate);
     }
     if (!refitted) {
-      bvh = build_bvh(mesh, BvhParams{config.bvh_leaf_size});
+      BvhParams params;
+      params.leaf_size = config.bvh_leaf_size > 0 ? config.bvh_leaf_size : (bundles ? 16 : 4);
+      params.traversal_cost = config.bvh_traversal_cost > 0.0f ? config.bvh_traversal_cost : (bundles ? 3.0f : 1.0f);
+      bvh = build_bvh(mesh, params);
       built_sah = sah_cost(bvh);
     }
     order = &bvh.order;

@@ -8,8 +8,8 @@
 // * Boxes are padded by 1e-6 of the mesh's largest coordinate (flat boxes of axis-aligned
 //   faces stay hittable despite rounding in the slab tests).
 // * A node is split along the best of 3 axes x 16 centroid bins by the surface-area heuristic
-//   (traversal cost 1, triangle cost 1); it stays a leaf when it holds at most `leaf_size`
-//   triangles and no split is cheaper than testing them all. Nodes with more triangles are
+//   (`traversal_cost` per node visit, 1 per triangle test); it stays a leaf when it holds at
+//   most `leaf_size` triangles and no split is cheaper than testing them all. Nodes with more triangles are
 //   always split (at the object median when the centroids coincide), and below depth 40 the
 //   split is the object median, so the depth stays under 72 for up to 2^32 triangles (the
 //   device stack holds 96).
@@ -24,7 +24,8 @@
 namespace sdfkit::cl {
 
 struct BvhParams {
-  int leaf_size = 4;  // >= 1
+  int leaf_size = 4;           // >= 1
+  float traversal_cost = 1.0f;  // a node visit in triangle tests, > 0
 };
 
 // One flattened node, as the device reads it (two float4: min + word, max + word).

@@ -56,8 +56,13 @@ struct OpenClConfig {
   // Octree: deepest level (root = 0) and the triangle count under which a node stays a leaf.
   int octree_max_depth = 10;
   int octree_leaf_size = 8;
-  // BVH: the triangle count under which the SAH may stop splitting.
-  int bvh_leaf_size = 4;
+  // BVH: the triangle count under which the SAH may stop splitting, and a node visit's cost in
+  // triangle tests; 0 = by tracer: bundles 16 and 3 (a bundle's node visit is two 16-lane box
+  // tests and a reduction, about three of its triangle tests: elephant / armadillo / bunny00 at
+  // 30 rays 12.1 / 162 / 212 ms with 4 and 1, 10.5 / 150 / 200 ms with 16 and 3), single rays
+  // 4 and 1.
+  int bvh_leaf_size = 0;
+  float bvh_traversal_cost = 0.0f;
   // BVH: update_positions refits the tree (new boxes, same tree: O(n) instead of a build) while
   // its SAH cost stays within this factor of the last full build's; past it, or when a triangle
   // that was degenerate at the build is not any more, it rebuilds. 0 = always rebuild. The
