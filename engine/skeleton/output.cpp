@@ -4,8 +4,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <functional>
+#include <iterator>
+#include <map>
 #include <ostream>
-#include <set>
+#include <vector>
 
 namespace sdfkit::skeleton {
 
@@ -37,17 +41,48 @@ void write_obj(std::ostream& out, const Skeleton& s) {
 }
 
 int cycle_count(const Skeleton& s) {
-  // First Betti number of the 1- and 2-cells: E - V + components - F (sheets enclose no volume).
+  // First Betti number over Z/2: dim ker(boundary of edges) - rank(boundary of triangles)
+  // = (E - V + components) - rank. Triangles whose boundaries add up to zero (a closed sheet
+  // around a void) do not lower it, so it never goes negative.
   const std::size_t v = s.nodes.size();
-  std::set<std::array<std::uint32_t, 2>> edges(s.edges.begin(), s.edges.end());
-  for (const Triangle& t : s.sheet_triangles)
-    for (int i = 0; i < 3; ++i)
-      edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+  std::map<std::array<std::uint32_t, 2>, std::uint32_t> edge_index;
+  auto edge = [&](std::uint32_t a, std::uint32_t b) {
+    const std::array<std::uint32_t, 2> key{std::min(a, b), std::max(a, b)};
+    return edge_index.emplace(key, static_cast<std::uint32_t>(edge_index.size())).first->second;
+  };
+  for (const auto& e : s.edges) edge(e[0], e[1]);
+  std::vector<std::vector<std::uint32_t>> columns;  // per sheet triangle: its edges, descending
+  for (const Triangle& t : s.sheet_triangles) {
+    std::vector<std::uint32_t> c{edge(t[0], t[1]), edge(t[1], t[2]), edge(t[2], t[0])};
+    std::sort(c.begin(), c.end(), std::greater<>());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+    columns.push_back(std::move(c));
+  }
   UnionFind uf(v);
   std::size_t components = v;
-  for (const auto& e : edges) components -= uf.unite(e[0], e[1]);
-  return static_cast<int>(edges.size()) - static_cast<int>(v) + static_cast<int>(components) -
-         static_cast<int>(s.sheet_triangles.size());
+  for (const auto& [key, index] : edge_index) components -= uf.unite(key[0], key[1]);
+  // Rank of the triangle-to-edge boundary matrix by column reduction: a column is reduced by
+  // the column owning its largest edge until that edge is new (a pivot) or the column is empty.
+  std::map<std::uint32_t, std::size_t> pivot_of;  // largest edge -> column
+  std::size_t rank = 0;
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    std::vector<std::uint32_t>& c = columns[k];
+    while (!c.empty()) {
+      const auto owner = pivot_of.find(c.front());
+      if (owner == pivot_of.end()) {
+        pivot_of.emplace(c.front(), k);
+        ++rank;
+        break;
+      }
+      std::vector<std::uint32_t> sum;  // symmetric difference, still descending
+      std::set_symmetric_difference(c.begin(), c.end(), columns[owner->second].begin(),
+                                    columns[owner->second].end(), std::back_inserter(sum),
+                                    std::greater<>());
+      c = std::move(sum);
+    }
+  }
+  return static_cast<int>(edge_index.size()) - static_cast<int>(v) + static_cast<int>(components) -
+         static_cast<int>(rank);
 }
 
 }  // namespace sdfkit::skeleton

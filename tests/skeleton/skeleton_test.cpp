@@ -236,6 +236,34 @@ TEST(Skeleton, SeveralComponentsGiveOnePartEach) {
     EXPECT_EQ(s.nodes[e[0]].vertices.front() < offset, s.nodes[e[1]].vertices.front() < offset);
 }
 
+// cycle_count is the first Betti number of curves plus sheets: a closed sheet (a tetrahedron's
+// surface) encloses a void and adds no cycle, a disc adds none, a ring of curve edges or a curve
+// edge across a sheet's open wedge adds one.
+TEST(Skeleton, CycleCountIsTheFirstBettiNumberOfCurvesAndSheets) {
+  auto with_nodes = [](std::size_t n) {
+    sk::Skeleton s;
+    s.nodes.resize(n);
+    return s;
+  };
+  sk::Skeleton tetra = with_nodes(4);
+  tetra.sheet_triangles = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {2, 3, 0}};
+  EXPECT_EQ(sk::cycle_count(tetra), 0);  // E - V + C - F would be -1
+  sk::Skeleton disc = with_nodes(5);  // a fan of three triangles around node 0
+  disc.sheet_triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}};
+  EXPECT_EQ(sk::cycle_count(disc), 0);
+  disc.edges = {{4, 1}};  // closes the open wedge 0-4-1 with a curve edge: one cycle
+  EXPECT_EQ(sk::cycle_count(disc), 1);
+  sk::Skeleton ring = with_nodes(6);
+  ring.edges = {{0, 1}, {1, 2}, {2, 0}, {2, 3}};
+  ring.sheet_triangles = {{3, 4, 5}};
+  EXPECT_EQ(sk::cycle_count(ring), 1);
+  sk::Skeleton two_tetras = with_nodes(8);  // two closed sheets joined by a curve edge
+  for (std::uint32_t o : {0u, 4u})
+    for (const auto& t : tetra.sheet_triangles) two_tetras.sheet_triangles.push_back({t[0] + o, t[1] + o, t[2] + o});
+  two_tetras.edges = {{0, 4}};
+  EXPECT_EQ(sk::cycle_count(two_tetras), 0);
+}
+
 TEST(Skeleton, JsonAndObjCarryNodesEdgesAndSheets) {
   const auto plate = models::c_shape();
   const sk::Skeleton s = run(plate.mesh, true, true);

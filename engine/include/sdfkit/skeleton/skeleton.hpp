@@ -200,7 +200,8 @@ std::string to_json(const Skeleton& skeleton);
 void write_obj(std::ostream& out, const Skeleton& skeleton);
 
 // Independent cycles of the skeleton as a 2-complex (curve edges, sheet triangles and their
-// edges): E - V + components - F, i.e. the first Betti number when sheets enclose no volume.
+// edges): its first Betti number over Z/2, E - V + components - rank of the triangles'
+// boundaries (= E - V + components - F unless sheets close around a void; never negative).
 // For a curve skeleton (no sheets) this is the number of handles of the shape.
 int cycle_count(const Skeleton& skeleton);
 
