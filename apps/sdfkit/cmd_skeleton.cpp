@@ -57,6 +57,9 @@ void add_skeleton_command(CLI::App& app) {
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
   add_sdf_options(*cmd, a->sdf);
   add_output_options(*cmd, a->sdf, false);
+  cmd->get_option("--backend")
+      ->description("auto | vulkan | opencl (auto: OpenCL when a device exists, else Vulkan: the SDF is "
+                    "recomputed at every contraction iteration, where the ray caster's calls are cheapest)");
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
     const std::string ext = extension_of(a->output);
@@ -65,7 +68,9 @@ void add_skeleton_command(CLI::App& app) {
     if (a->sdf.sdf.domain != SdfDomain::Vertex) throw InputError("skeletons use the per-vertex SDF (--per vertex)");
     const auto t0 = std::chrono::steady_clock::now();
     const io::Asset asset = load_input(a->input, a->sdf.load);
-    std::unique_ptr<SdfBackend> backend = make_backend(a->sdf.backend_config);
+    BackendConfig backend_config = a->sdf.backend_config;
+    backend_config.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan};
+    std::unique_ptr<SdfBackend> backend = make_backend(backend_config);
 
     skeleton::ContractionOptions contraction;
     contraction.sdf_term = !a->no_sdf_term;

@@ -89,7 +89,8 @@ std::unique_ptr<SdfBackend> make_backend(const BackendConfig& config) {
     case BackendKind::Auto: break;
   }
   std::string reasons;
-  for (BackendKind kind : {BackendKind::Vulkan, BackendKind::OpenCL}) {
+  for (BackendKind kind : config.auto_order) {
+    if (kind == BackendKind::Auto) continue;
     try {
       return kind == BackendKind::Vulkan ? make_vulkan(config) : make_opencl(config);
     } catch (const DeviceError& e) {

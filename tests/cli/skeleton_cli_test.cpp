@@ -1,6 +1,6 @@
-// `sdfkit skeleton` end to end on PoCL: a capsule's skeleton is one curve along its axis, the
-// glb output carries the skeleton as its own node and reads back as the surface alone, and an
-// open mesh is one clean error.
+// `sdfkit skeleton` end to end on PoCL (auto picks it for skeletons): a capsule's skeleton is one
+// curve along its axis, the glb output carries the skeleton as its own node and reads back as
+// the surface alone, and an open mesh is one clean error.
 #include "analytic.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +12,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 namespace fs = std::filesystem;
 
@@ -26,7 +28,13 @@ TEST(SkeletonCli, CapsuleGivesOneCurveAlongItsAxis) {
   const fs::path dir = fs::temp_directory_path() / "sdfkit_skeleton_cli";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  ASSERT_EQ(run("skeleton builtin:capsule -o " + (dir / "s.json").string() + " --backend opencl --rays 12", dir / "log"), 0);
+  // --backend auto (the default) picks the OpenCL ray caster for skeletons when it has a device.
+  ASSERT_EQ(run("skeleton builtin:capsule -o " + (dir / "s.json").string() + " --rays 12", dir / "log"), 0);
+  {
+    std::ifstream log(dir / "log");
+    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("with the opencl SDF"), std::string::npos) << text;
+  }
   std::ifstream f(dir / "s.json");
   const auto j = nlohmann::json::parse(f);
   const auto& nodes = j.at("nodes");
