@@ -39,6 +39,13 @@ double children_cpu_s() {
          static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec) / 1e6;
 }
 
+// Peak resident set size of this process so far, MiB (Linux reports ru_maxrss in KiB).
+double peak_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -128,6 +135,7 @@ BackendRun time_backend(const std::string& name, const Mesh& mesh, const SdfOpti
     run.repeat_cpu_ms = warm_cpu.empty() ? 0.0 : median(warm_cpu);
     run.stages = backend->last_timings();
     run.device_bytes = backend->device_memory_bytes();
+    run.peak_rss_mib = peak_rss_mib();
     std::size_t valid = 0;
     for (auto v : query.valid) valid += v;
     double trace = stage_ms(run.stages, "trace");
@@ -293,7 +301,8 @@ nlohmann::json to_json(const std::vector<MeshResult>& results, const BenchOption
     for (const BackendRun& b : m.runs) {
       nlohmann::json jb = {{"backend", b.backend}, {"device", b.device}, {"mode", b.mode},
                            {"session_ms", b.session_ms}, {"first_ms", b.first_ms}, {"repeat_ms", b.repeat_ms}, {"repeat_cpu_ms", b.repeat_cpu_ms},
-                           {"rays_per_second", b.rays_per_second}, {"device_bytes", b.device_bytes}};
+                           {"rays_per_second", b.rays_per_second}, {"device_bytes", b.device_bytes},
+                           {"peak_rss_mib_after", b.peak_rss_mib}};
       nlohmann::json st = nlohmann::json::object();
       for (const auto& s : b.stages) st[s.stage] = s.milliseconds;
       jb["stages_ms"] = st;
@@ -312,6 +321,7 @@ nlohmann::json to_json(const std::vector<MeshResult>& results, const BenchOption
     if (m.smooth_ms) jm["smooth_ms"] = *m.smooth_ms;
     j["meshes"].push_back(jm);
   }
+  j["peak_rss_mib"] = peak_rss_mib();
   return j;
 }
 
@@ -396,14 +406,20 @@ std::string to_markdown(const std::vector<MeshResult>& results, const BenchOptio
         md << "| " << m.name << " | " << b.backend << " | " << b.mode << " | " << fmt(b.session_ms / 1000.0, "%.3f")
            << " | " << fmt(b.first_ms / 1000.0, "%.3f")
            << " | " << fmt(b.repeat_ms / 1000.0, "%.3f") << " |\n";
-  md << "\nPer-stage times of the last call (ms):\n\n| mesh | backend | mode | stages |\n|---|---|---|---|\n";
+  md << "\nPer-stage times of the last call (ms) and the memory the backend reports for its session "
+        "(device buffers: geometry and per-batch; Embree: the peak its scene allocated, on the "
+        "host):\n\n"
+        "| mesh | backend | mode | stages | backend MiB |\n|---|---|---|---|---:|\n";
   for (const MeshResult& m : results)
     for (const BackendRun& b : m.runs) {
       std::string st;
       for (const auto& s : b.stages) st += s.stage + " " + fmt(s.milliseconds, "%.1f") + ", ";
       if (!b.error.empty()) st = "error: " + b.error;
-      md << "| " << m.name << " | " << b.backend << " | " << b.mode << " | " << st << " |\n";
+      md << "| " << m.name << " | " << b.backend << " | " << b.mode << " | " << st << " | "
+         << (b.device_bytes > 0 ? fmt(static_cast<double>(b.device_bytes) / (1 << 20), "%.1f") : "–") << " |\n";
     }
+  md << "\nPeak resident memory of the benchmark process (all backends, all meshes): "
+     << fmt(peak_rss_mib(), "%.0f") << " MiB.\n";
   return md.str();
 }
 

@@ -40,11 +40,12 @@ struct BackendRun {
   std::string backend, device, mode;  // mode: "vertex/30 rays", "face/25 rays", "vertex/128 views 512px"
   double session_ms = 0;     // creating the backend session (device, programs, pipelines)
   double first_ms = 0;       // set_mesh + compute, cold
-  double repeat_ms = 0;      // update_positions + compute, median of repeats
+  double repeat_ms = 0;      // update_positions (or set_mesh) + compute, median of repeats
   double repeat_cpu_ms = 0;  // process CPU time (all threads) of the median warm call
   std::vector<StageTiming> stages;  // of the last call
   double rays_per_second = 0;  // ray backends: valid points * rays / trace time
-  std::size_t device_bytes = 0;
+  std::size_t device_bytes = 0;  // the session's device buffers (backend's own count)
+  double peak_rss_mib = 0;       // the process's peak resident memory after this run
   std::optional<FieldComparison> vs_reference;
   std::string error;
 };
