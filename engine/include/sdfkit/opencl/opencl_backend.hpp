@@ -73,8 +73,9 @@ struct OpenClConfig {
   // busy) instead of one ray per work item. Unset: bundles on CPU devices, single rays on GPUs
   // (whose work items are scalar lanes already).
   std::optional<bool> bvh_bundles;
-  // Work-group size of the trace and gather kernels; 0 = 32 on CPU devices (measured: the
-  // driver's choice left a core idle at the end of small launches), the driver's on GPUs.
+  // Work-group size of the trace and gather kernels; 0 = 8 on CPU devices (measured: the
+  // driver's choice left a core idle at the end of small launches, and a bundle work item
+  // traces 16 rays, so small groups balance the skeleton's small calls), the driver's on GPUs.
   std::size_t work_group_size = 0;
 };
 
