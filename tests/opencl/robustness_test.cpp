@@ -5,6 +5,7 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
+#include "sdfkit/opencl/bvh.hpp"
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -206,6 +207,22 @@ TEST(OpenClRobustness, SmallMemoryCapBatchesWithoutChangingResults) {
   EXPECT_EQ(a.values, b.values);
   EXPECT_EQ(a.kept_rays, b.kept_rays);
   EXPECT_GT(small.device_memory_bytes(), 0u);
+}
+
+// Configuration values out of range are refused before any device work, with InputError.
+TEST(OpenClRobustness, BadConfigurationIsAnInputError) {
+  auto with = [](auto change) {
+    cl::OpenClConfig c;
+    change(c);
+    return c;
+  };
+  EXPECT_THROW(cl::OpenClBackend{with([](auto& c) { c.memory_cap = 0; })}, InputError);
+  EXPECT_THROW(cl::OpenClBackend{with([](auto& c) { c.bvh_leaf_size = -1; })}, InputError);
+  EXPECT_THROW(cl::OpenClBackend{with([](auto& c) { c.bvh_traversal_cost = -1.0f; })}, InputError);
+  EXPECT_THROW(cl::OpenClBackend{with([](auto& c) { c.bvh_traversal_cost = NAN; })}, InputError);
+  EXPECT_THROW(cl::OpenClBackend{with([](auto& c) { c.bvh_refit_limit = -0.5; })}, InputError);
+  EXPECT_THROW(cl::OpenClBackend{with([](auto& c) { c.bvh_refit_limit = INFINITY; })}, InputError);
+  EXPECT_THROW(sdfkit::cl::build_bvh(shapes::icosphere(1.0f, 1), {4, 0.0f}), InputError);
 }
 
 TEST(OpenClRobustness, DeviceSelectionByIndexNameAndUnknown) {
