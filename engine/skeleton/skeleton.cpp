@@ -237,6 +237,24 @@ struct ContractedProxy {
   const std::vector<std::uint32_t>& vertex_map;  // per input vertex: its proxy vertex
 };
 
+// Per proxy vertex: the input vertices merged into it (vertex_map: per input vertex its proxy
+// vertex).
+std::vector<std::vector<std::uint32_t>> proxy_inputs(const std::vector<std::uint32_t>& vertex_map,
+                                                     std::size_t proxy_vertices) {
+  std::vector<std::vector<std::uint32_t>> inputs(proxy_vertices);
+  for (std::uint32_t k = 0; k < vertex_map.size(); ++k) inputs[vertex_map[k]].push_back(k);
+  return inputs;
+}
+
+// The mean of values[k] over `members`, summed as Sum; `none` when there are no members.
+template <typename Sum, typename T>
+T mean_over(const std::vector<std::uint32_t>& members, const std::vector<T>& values, T none) {
+  if (members.empty()) return none;
+  Sum sum(0.0);
+  for (std::uint32_t k : members) sum += Sum(values[k]);
+  return T(sum / static_cast<double>(members.size()));
+}
+
 // Connectivity surgery on the contracted input, or on the contracted proxy with per proxy
 // vertex the mean local radius and centre point of its input vertices; node members are input
 // vertices either way.
@@ -244,17 +262,12 @@ detail::CurveGraph surgery(const Surface& surface, const std::vector<float>& loc
                            const ContractedProxy* proxy, const detail::SurgeryOptions& so) {
   if (proxy == nullptr) return detail::collapse_to_curves(surface.contracted, local_radius, surface.centre, so);
   const std::size_t m = proxy->contracted.positions.size();
-  std::vector<std::vector<std::uint32_t>> inputs(m);
-  for (std::uint32_t k = 0; k < proxy->vertex_map.size(); ++k) inputs[proxy->vertex_map[k]].push_back(k);
-  std::vector<float> radius(m, 0.0f);
+  const std::vector<std::vector<std::uint32_t>> inputs = proxy_inputs(proxy->vertex_map, m);
+  std::vector<float> radius(m);
   std::vector<glm::vec3> centre(m);
   for (std::uint32_t p = 0; p < m; ++p) {
-    double r = 0.0;
-    glm::dvec3 c(0.0);
-    for (std::uint32_t k : inputs[p]) r += local_radius[k], c += glm::dvec3(surface.centre[k]);
-    const double count = std::max<double>(1.0, static_cast<double>(inputs[p].size()));
-    radius[p] = static_cast<float>(r / count);
-    centre[p] = inputs[p].empty() ? proxy->contracted.positions[p] : glm::vec3(c / count);
+    radius[p] = mean_over<double>(inputs[p], local_radius, 0.0f);
+    centre[p] = mean_over<glm::dvec3>(inputs[p], surface.centre, proxy->contracted.positions[p]);
   }
   detail::CurveGraph graph = detail::collapse_to_curves(proxy->contracted, radius, centre, so);
   for (std::vector<std::uint32_t>& members : graph.members) {
@@ -513,25 +526,22 @@ Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions
               std::to_string(proxy.collapses) + " collapses, " + std::to_string(proxy.refused) +
               " refused) in " + std::to_string(1e3 * seconds.simplify) + " ms");
   }
-  // The input's own SDF at full quality (radii, centre points, grouping, Skeleton::sdf). With a
-  // proxy it is measured first, and each proxy vertex starts the contraction from the mean over
-  // the input vertices merged into it (the proxy stands for the input's surface; one SDF at full
-  // quality instead of two). Without a proxy it is the contraction's first SDF.
+  // The input's own SDF at full quality (radii, centre points, grouping, Skeleton::sdf): the
+  // contraction's first SDF when it contracts the input with the SDF term, else measured here
+  // first. With a proxy, each proxy vertex then starts the contraction from the mean over the
+  // input vertices merged into it (the proxy stands for the input's surface; one SDF at full
+  // quality instead of two).
+  const bool contraction_measures_input = !use_proxy && contraction.sdf_term;
   std::vector<float> sdf, proxy_first_sdf;
-  if (use_proxy && backend != nullptr) {
+  if (backend != nullptr && !contraction_measures_input) {
     t = Clock::now();
     backend->set_mesh(mesh);
     sdf = compute_sdf(*backend, mesh, so).values;
     seconds.input_sdf = seconds_since(t);
-    if (contraction.sdf_term) {
-      proxy_first_sdf.assign(proxy.mesh.positions.size(), 0.0f);
-      std::vector<std::uint32_t> count(proxy.mesh.positions.size(), 0);
-      for (std::size_t k = 0; k < proxy.vertex_map.size(); ++k) {
-        proxy_first_sdf[proxy.vertex_map[k]] += sdf[k];
-        ++count[proxy.vertex_map[k]];
-      }
-      for (std::size_t p = 0; p < count.size(); ++p)
-        if (count[p] > 0) proxy_first_sdf[p] /= static_cast<float>(count[p]);
+    if (use_proxy && contraction.sdf_term) {
+      const auto inputs = proxy_inputs(proxy.vertex_map, proxy.mesh.positions.size());
+      proxy_first_sdf.resize(inputs.size());
+      for (std::size_t p = 0; p < inputs.size(); ++p) proxy_first_sdf[p] = mean_over<float>(inputs[p], sdf, 0.0f);
     }
   }
   t = Clock::now();
@@ -539,13 +549,7 @@ Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions
   seconds.contraction = seconds_since(t);
   seconds.contraction_sdf = c.sdf_seconds;
   seconds.contraction_solve = c.solve_seconds;
-  if (!use_proxy) sdf = std::move(c.first_sdf);
-  if (backend != nullptr && sdf.empty()) {  // the plain contraction measured no SDF
-    t = Clock::now();
-    backend->set_mesh(mesh);
-    sdf = compute_sdf(*backend, mesh, so).values;
-    seconds.input_sdf = seconds_since(t);
-  }
+  if (contraction_measures_input) sdf = std::move(c.first_sdf);
 
   t = Clock::now();
   Skeleton sk;
