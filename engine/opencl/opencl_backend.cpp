@@ -282,12 +282,10 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
   const std::vector<std::uint32_t>* order = nullptr;
   refitted = false;
   if (config.accel == Accel::Bvh) {
-    // After update_positions: refit while the tree stays nearly as good as a fresh build.
-    if (positions_moved && config.bvh_refit_limit > 0.0 && !bvh.nodes.empty()) {
-      Bvh candidate = bvh;
-      refitted = refit_bvh(candidate, mesh) && sah_cost(candidate) <= config.bvh_refit_limit * built_sah;
-      if (refitted) bvh = std::move(candidate);
-    }
+    // After update_positions: refit while the tree stays nearly as good as a fresh build (a
+    // refused or too costly refit is replaced by the build below).
+    refitted = positions_moved && config.bvh_refit_limit > 0.0 && !bvh.nodes.empty() &&
+               refit_bvh(bvh, mesh) && sah_cost(bvh) <= config.bvh_refit_limit * built_sah;
     if (!refitted) {
       BvhParams params;
       params.leaf_size = config.bvh_leaf_size > 0 ? config.bvh_leaf_size : (bundles ? 16 : 4);
