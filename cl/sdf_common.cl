@@ -4,12 +4,15 @@
 // Contraction of a*b+c into fma is off so every formula rounds like the C++ definition.
 #pragma OPENCL FP_CONTRACT OFF
 
+// The definition's constants, false-hit rule, cone test and weight, shared with C++ and GLSL
+// (expanded in place when the kernels are embedded).
+#include "sdfkit/core/sdf_definition_shared.h"
+
 // Build options supply STACK_SIZE (traversal stack entries).
 #ifndef STACK_SIZE
 #define STACK_SIZE 128
 #endif
 
-#define MIN_RAY_ANGLE 1e-3f
 #define NO_HIT_KEY 0xFFFFFFFFFFFFFFFFUL
 
 // Duff et al. 2017 orthonormal frame around a unit axis, as sdfkit::tangent_frame.
@@ -30,24 +33,8 @@ inline float3 ray_direction(float3 outward_normal, float3 local_dir) {
   return t * local_dir.x + b * local_dir.y + axis * local_dir.z;
 }
 
-// The cone table: ray i of n in the cone's local frame (xyz) and its weight 1/max(theta, min)
-// (w). one_minus_cos = 1 - cos(aperture/2). The golden angle in turns is split into c_hi, whose
-// products with i < 2^10 are exact in float, plus the small c_lo, so phi keeps full precision.
-__kernel void make_cone(int n, float one_minus_cos, float c_hi, float c_lo,
-                        __global float4* table) {
-  const int i = get_global_id(0);
-  if (i >= n) return;
-  const float x = one_minus_cos * ((float)i + 0.5f) / (float)n;  // 1 - cos(theta)
-  const float cos_t = 1.0f - x;
-  const float sin_t = sqrt(x * (2.0f - x));
-  const float hi = (float)i * c_hi;
-  float turns = (hi - floor(hi)) + (float)i * c_lo;
-  turns -= floor(turns);
-  const float phi = turns * 6.283185307179586f;
-  const float theta = 2.0f * asin(sqrt(0.5f * x));
-  table[i] = (float4)(sin_t * cos(phi), sin_t * sin(phi), cos_t,
-                      1.0f / fmax(theta, MIN_RAY_ANGLE));
-}
+// The cone table (computed on the host by sdfkit::cone_rays and uploaded): ray i in the cone's
+// local frame (xyz) and its weight 1/max(theta, SDFKIT_MIN_RAY_ANGLE) (w).
 
 // Test entry: the world directions (xyz) and weights (w) of every ray of every normal,
 // point-major.
@@ -57,4 +44,19 @@ __kernel void ray_directions(__global const float4* normals, __global const floa
   if (g >= n_points * (uint)n_rays) return;
   const uint p = g / (uint)n_rays, r = g - p * (uint)n_rays;
   out[g] = (float4)(ray_direction(normals[p].xyz, table[r].xyz), table[r].w);
+}
+
+// Test entry: the shared false-hit rule and cone test on the device. Per case: start normal
+// (outward), ray direction, hit normal (outward), each xyz of a float4, and in the start
+// normal's w the cosine of the cone's half-angle. Writes bit 0 = sdfkit_accept_hit(Paper),
+// bit 1 = sdfkit_accept_hit(Cgal), bit 2 = sdfkit_in_cone(-start normal, direction, cos).
+__kernel void definition_probe(__global const float4* cases, uint n, __global uint* out) {
+  const uint g = get_global_id(0);
+  if (g >= n) return;
+  const float4 start = cases[3 * g], dir = cases[3 * g + 1], hit = cases[3 * g + 2];
+  uint bits = 0;
+  if (sdfkit_accept_hit(SDFKIT_RULE_PAPER, start.xyz, dir.xyz, hit.xyz)) bits |= 1u;
+  if (sdfkit_accept_hit(SDFKIT_RULE_CGAL, start.xyz, dir.xyz, hit.xyz)) bits |= 2u;
+  if (sdfkit_in_cone(-start.xyz, dir.xyz, start.w)) bits |= 4u;
+  out[g] = bits;
 }

@@ -207,9 +207,7 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
 #endif
     if (f != 0xffffffffu) {
       const float3 hn = (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
-      // Paper: drop hits facing the same way as the start normal; Cgal: keep exits only.
-      const bool accept = rule == 0 ? dot(hn, n) <= 0.0f : dot(d, hn) > 0.0f;
-      if (accept) key = ((ulong)as_uint(t) << 32) | (ulong)r;
+      if (sdfkit_accept_hit((uint)rule, n, d, hn)) key = ((ulong)as_uint(t) << 32) | (ulong)r;
     }
   }
   keys[g] = key;
@@ -223,7 +221,10 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
 // last point or of points that cast no rays are inactive (best distance -1: nothing can be
 // entered or hit). A node is entered when any active ray enters it; pending nodes keep the
 // smallest entry distance of their rays and are dropped once every ray has a closer hit.
-#define BUNDLE 16  // = kBundle in opencl_backend.cpp
+#define BUNDLE SDFKIT_BUNDLE_WIDTH  // float16 lanes: the code below is written for 16
+#if BUNDLE != 16
+#error "trace_bundles is written for bundles of 16 (float16)"
+#endif
 // The bundle's triangle test rounds like the scalar one and the C++ definition's tests: no
 // contraction (with fma, rays through a shared edge of an axis-aligned face slipped between
 // both triangles).
@@ -375,8 +376,7 @@ __kernel void trace_bundles(__global const float4* bvh, __global const float4* t
       const float3 n = normals[p].xyz;
       const float3 hn = (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
       const float3 d = (float3)(dxs[l], dys[l], dzs[l]);
-      const bool accept = rule == 0 ? dot(hn, n) <= 0.0f : dot(d, hn) > 0.0f;
-      if (accept) key = ((ulong)as_uint(ts[l]) << 32) | (ulong)r;
+      if (sdfkit_accept_hit((uint)rule, n, d, hn)) key = ((ulong)as_uint(ts[l]) << 32) | (ulong)r;
     }
     keys[(size_t)p * n_rays + r] = key;
   }

@@ -1,4 +1,8 @@
-// Shared by the depth-peeling shaders: camera records and the layer-image encoding.
+// Shared by the depth-peeling shaders: camera records and the layer-image encoding. The
+// definition's constants and rules come from the header C++ and OpenCL C include too.
+#ifndef SDFKIT_DEPTH_PEEL_COMMON_GLSL
+#define SDFKIT_DEPTH_PEEL_COMMON_GLSL
+#include "sdfkit/core/sdf_definition_shared.h"
 
 // One orthographic camera: right and up span the image, dir is the viewing direction (depth
 // grows along it). xyz used, w padding.
@@ -8,9 +12,8 @@ struct Camera {
   vec4 dir;
 };
 
-// Layer images are R32G32_UINT: x = depth bits (float, 0..1; kNoSurface where nothing was drawn),
-// y = the outward unit normal, octahedral-encoded in two snorm16.
-const float kNoSurface = 2.0;
+// Layer images are R32G32_UINT: x = depth bits (float, 0..1; SDFKIT_NO_SURFACE where nothing was
+// drawn), y = the outward unit normal, octahedral-encoded in two snorm16.
 
 vec2 oct_wrap(vec2 v) { return (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
 
@@ -40,3 +43,5 @@ float corrected_depth(float z, vec3 normal, ivec2 px, vec2 pos, Camera cam, int 
   const float dz = (slope_r * delta.x + slope_u * delta.y) / float(resolution);
   return z + clamp(dz, -2.0 / float(resolution), 2.0 / float(resolution));
 }
+
+#endif  // SDFKIT_DEPTH_PEEL_COMMON_GLSL

@@ -15,6 +15,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Points {
 };
 layout(std430, set = 0, binding = 2) buffer Counts { uint counts[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Samples { vec2 samples[]; };
+#include "peel_samples.glsl"
 layout(set = 0, binding = 4) uniform usampler2DArray previous_layer;
 layout(set = 0, binding = 5) uniform usampler2DArray current_layer;
 // Per peel step of a submission: points whose exit may still lie in a deeper layer.
@@ -28,19 +29,19 @@ layout(push_constant) uniform Push {
   uint point_count;
   uint max_samples;
   float cos_half_cone;
-  uint rule;            // 0 = Paper, 1 = Cgal
+  uint rule;            // SDFKIT_RULE_PAPER or SDFKIT_RULE_CGAL
   int resolution;
   float front_tolerance;  // normalised depth
   uint pending_slot;
 } pc;
 
 // Depth of the layer texel at `px`, moved along the surface plane to the sub-pixel position
-// `pos` (pixels); kNoSurface when the texel is empty. Returns the decoded normal too.
+// `pos` (pixels); SDFKIT_NO_SURFACE when the texel is empty. Returns the decoded normal too.
 float layer_depth(usampler2DArray layer_image, ivec2 px, int layer, vec2 pos, Camera cam, out vec3 normal) {
   const uvec2 t = texelFetch(layer_image, ivec3(px, layer), 0).xy;
   const float z = uintBitsToFloat(t.x);
   normal = vec3(0.0);
-  if (z >= 1.5) return kNoSurface;
+  if (z >= SDFKIT_NO_SURFACE_BELOW) return SDFKIT_NO_SURFACE;
   normal = decode_normal(t.y);
   return corrected_depth(z, normal, px, pos, cam, pc.resolution);
 }
@@ -52,47 +53,34 @@ void main() {
   if (origin.w == 0.0) return;
   const vec3 inward = points[pc.point_count + i].xyz;
   const vec3 q = (origin.xyz - pc.center_scale.xyz) * pc.center_scale.w;  // in units of R
-  const float res = float(pc.resolution);
-
   for (uint c = 0u; c < pc.camera_count; ++c) {
     const Camera cam = cams[pc.camera_base + c];
-    const float cos_theta = dot(inward, cam.dir.xyz);
-    if (cos_theta < pc.cos_half_cone) continue;
-    const vec2 ndc = vec2(dot(q, cam.right.xyz), dot(q, cam.up.xyz));
-    const vec2 pos = (ndc * 0.5 + 0.5) * res;  // framebuffer position in pixels
-    const ivec2 px = ivec2(floor(pos));
-    if (any(lessThan(px, ivec2(0))) || any(greaterThanEqual(px, ivec2(pc.resolution)))) continue;
-    const float zp = dot(q, cam.dir.xyz) * 0.5 + 0.5;
+    PointView v;
+    if (!view_point(cam, q, inward, pc.cos_half_cone, pc.resolution, v)) continue;
     const int back = int(2u * c + 1u);
 
     vec3 back_normal;
-    const float z1 = layer_depth(current_layer, px, back, pos, cam, back_normal);
-    if (z1 >= 1.5) continue;  // no back layer k here: none deeper either
-    if (!(zp < z1)) {
+    const float z1 = layer_depth(current_layer, v.px, back, v.pos, cam, back_normal);
+    if (z1 >= SDFKIT_NO_SURFACE_BELOW) continue;  // no back layer k here: none deeper either
+    if (!(v.zp < z1)) {
       // The point lies behind back layer k: a later layer may hold its exit.
       atomicAdd(pending[pc.pending_slot], 1u);
       continue;
     }
     if (pc.first_layer == 0u) {
       vec3 n0;
-      const float z0 = layer_depth(previous_layer, px, back, pos, cam, n0);
-      if (!(z0 < zp)) continue;
+      const float z0 = layer_depth(previous_layer, v.px, back, v.pos, cam, n0);
+      if (!(z0 < v.zp)) continue;
     }
     // The closest hit: a front face of this layer between the point and the exit, if any.
     float z_hit = z1;
     vec3 hit_normal = back_normal;
     vec3 front_normal;
-    const float zf = layer_depth(current_layer, px, back - 1, pos, cam, front_normal);
-    if (zf < 1.5 && zf > zp + pc.front_tolerance && zf < z1) {
+    const float zf = layer_depth(current_layer, v.px, back - 1, v.pos, cam, front_normal);
+    if (zf < SDFKIT_NO_SURFACE_BELOW && zf > v.zp + pc.front_tolerance && zf < z1) {
       z_hit = zf;
       hit_normal = front_normal;
     }
-    const bool accepted = pc.rule == 0u ? dot(hit_normal, inward) >= 0.0    // hit . outward start <= 0
-                                        : dot(cam.dir.xyz, hit_normal) > 0.0;
-    if (!accepted) continue;
-    const float length_model = (z_hit - zp) * 2.0 / pc.center_scale.w;
-    const float theta = acos(clamp(cos_theta, -1.0, 1.0));
-    const uint slot = atomicAdd(counts[i], 1u);
-    if (slot < pc.max_samples) samples[i * pc.max_samples + slot] = vec2(length_model, theta);
+    store_hit(i, pc.rule, inward, cam, v, z_hit, hit_normal, pc.center_scale.w, pc.max_samples);
   }
 }

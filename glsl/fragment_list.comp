@@ -17,6 +17,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Points {
 };
 layout(std430, set = 0, binding = 2) buffer Counts { uint counts[]; };
 layout(std430, set = 0, binding = 3) writeonly buffer Samples { vec2 samples[]; };
+#include "peel_samples.glsl"
 layout(std430, set = 0, binding = 4) readonly buffer Heads { uint heads[]; };
 layout(std430, set = 0, binding = 5) readonly buffer Nodes { uint nodes[]; };
 layout(std430, set = 0, binding = 6) readonly buffer Counter { uint appended; };
@@ -28,7 +29,7 @@ layout(push_constant) uniform Push {
   uint point_count;
   uint max_samples;
   float cos_half_cone;
-  uint rule;            // 0 = Paper, 1 = Cgal
+  uint rule;            // SDFKIT_RULE_PAPER or SDFKIT_RULE_CGAL
   int resolution;
   float front_tolerance;  // normalised depth
   uint capacity;        // nodes
@@ -42,46 +43,32 @@ void main() {
   if (origin.w == 0.0) return;
   const vec3 inward = points[pc.point_count + i].xyz;
   const vec3 q = (origin.xyz - pc.center_scale.xyz) * pc.center_scale.w;  // in units of R
-  const float res = float(pc.resolution);
-
   for (uint c = 0u; c < pc.camera_count; ++c) {
     const Camera cam = cams[pc.camera_base + c];
-    const float cos_theta = dot(inward, cam.dir.xyz);
-    if (cos_theta < pc.cos_half_cone) continue;
-    const vec2 ndc = vec2(dot(q, cam.right.xyz), dot(q, cam.up.xyz));
-    const vec2 pos = (ndc * 0.5 + 0.5) * res;  // framebuffer position in pixels
-    const ivec2 px = ivec2(floor(pos));
-    if (any(lessThan(px, ivec2(0))) || any(greaterThanEqual(px, ivec2(pc.resolution)))) continue;
-    const float zp = dot(q, cam.dir.xyz) * 0.5 + 0.5;
+    PointView v;
+    if (!view_point(cam, q, inward, pc.cos_half_cone, pc.resolution, v)) continue;
 
-    float z_back = kNoSurface, z_front = kNoSurface;
+    float z_back = SDFKIT_NO_SURFACE, z_front = SDFKIT_NO_SURFACE;
     vec3 n_back = vec3(0.0), n_front = vec3(0.0);
-    uint node = heads[(c * uint(pc.resolution) + uint(px.y)) * uint(pc.resolution) + uint(px.x)];
-    while (node != kEndOfList) {
-      const uint bits = nodes[kNodeWords * node];
-      const vec3 n = decode_normal(nodes[kNodeWords * node + 1u]);
-      const float z = corrected_depth(uintBitsToFloat(bits & ~kFrontBit), n, px, pos, cam, pc.resolution);
-      if ((bits & kFrontBit) != 0u) {
-        if (z > zp + pc.front_tolerance && z < z_front) {
+    uint node = heads[(c * uint(pc.resolution) + uint(v.px.y)) * uint(pc.resolution) + uint(v.px.x)];
+    while (node != SDFKIT_END_OF_LIST) {
+      const uint bits = nodes[SDFKIT_NODE_WORDS * node];
+      const vec3 n = decode_normal(nodes[SDFKIT_NODE_WORDS * node + 1u]);
+      const float z = corrected_depth(uintBitsToFloat(bits & ~SDFKIT_FRONT_BIT), n, v.px, v.pos, cam, pc.resolution);
+      if ((bits & SDFKIT_FRONT_BIT) != 0u) {
+        if (z > v.zp + pc.front_tolerance && z < z_front) {
           z_front = z;
           n_front = n;
         }
-      } else if (z > zp && z < z_back) {
+      } else if (z > v.zp && z < z_back) {
         z_back = z;
         n_back = n;
       }
-      node = nodes[kNodeWords * node + 2u];
+      node = nodes[SDFKIT_NODE_WORDS * node + 2u];
     }
-    if (z_back >= 1.5) continue;  // no exit behind the point
+    if (z_back >= SDFKIT_NO_SURFACE_BELOW) continue;  // no exit behind the point
     const bool front_hit = z_front < z_back;
-    const float z_hit = front_hit ? z_front : z_back;
-    const vec3 hit_normal = front_hit ? n_front : n_back;
-    const bool accepted = pc.rule == 0u ? dot(hit_normal, inward) >= 0.0    // hit . outward start <= 0
-                                        : dot(cam.dir.xyz, hit_normal) > 0.0;
-    if (!accepted) continue;
-    const float length_model = (z_hit - zp) * 2.0 / pc.center_scale.w;
-    const float theta = acos(clamp(cos_theta, -1.0, 1.0));
-    const uint slot = atomicAdd(counts[i], 1u);
-    if (slot < pc.max_samples) samples[i * pc.max_samples + slot] = vec2(length_model, theta);
+    store_hit(i, pc.rule, inward, cam, v, front_hit ? z_front : z_back, front_hit ? n_front : n_back,
+              pc.center_scale.w, pc.max_samples);
   }
 }

@@ -8,7 +8,7 @@
 
 layout(std430, set = 0, binding = 0) readonly buffer Normals { vec4 normals[]; };  // per drawn triangle
 layout(std430, set = 0, binding = 2) buffer Heads { uint heads[]; };  // per camera of the batch, per pixel
-layout(std430, set = 0, binding = 3) writeonly buffer Nodes { uint nodes[]; };  // kNodeWords per node
+layout(std430, set = 0, binding = 3) writeonly buffer Nodes { uint nodes[]; };  // SDFKIT_NODE_WORDS per node
 layout(std430, set = 0, binding = 4) buffer Counter { uint appended; };  // may exceed the capacity
 
 layout(push_constant) uniform Push {
@@ -28,7 +28,7 @@ void main() {
   if (node >= pc.capacity) return;
   const ivec2 px = ivec2(gl_FragCoord.xy);
   const uint head = (in_camera * uint(pc.resolution) + uint(px.y)) * uint(pc.resolution) + uint(px.x);
-  nodes[kNodeWords * node] = floatBitsToUint(gl_FragCoord.z) | (gl_FrontFacing ? kFrontBit : 0u);
-  nodes[kNodeWords * node + 1u] = encode_normal(normals[in_triangle].xyz);
-  nodes[kNodeWords * node + 2u] = atomicExchange(heads[head], node);
+  nodes[SDFKIT_NODE_WORDS * node] = floatBitsToUint(gl_FragCoord.z) | (gl_FrontFacing ? SDFKIT_FRONT_BIT : 0u);
+  nodes[SDFKIT_NODE_WORDS * node + 1u] = encode_normal(normals[in_triangle].xyz);
+  nodes[SDFKIT_NODE_WORDS * node + 2u] = atomicExchange(heads[head], node);
 }

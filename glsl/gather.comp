@@ -1,8 +1,11 @@
 #version 450
 // Gather pass: the shared statistics of sdfkit::gather (sdf_definition.hpp) per point, on the
 // stored (length, theta) samples: sort by length (ties by slot), median = sorted[k / 2],
-// population sigma, keep |d - median| <= sigma, weights 1 / max(theta, kMinRayAngle), weighted
+// population sigma, keep |d - median| <= sigma, weights sdfkit_ray_weight(theta), weighted
 // mean. Sums are `precise` (no fused multiply-add) and accumulate in sorted order, like the C++.
+#extension GL_GOOGLE_include_directive : require
+#include "sdfkit/core/sdf_definition_shared.h"
+
 layout(local_size_x = 64) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer Counts { uint counts[]; };
@@ -13,7 +16,6 @@ layout(std430, set = 0, binding = 2) writeonly buffer Result { uvec4 result[]; }
 layout(push_constant) uniform Push {
   uint point_count;
   uint max_samples;
-  float min_ray_angle;
 } pc;
 
 void main() {
@@ -52,7 +54,7 @@ void main() {
   for (uint a = 0u; a < k; ++a) {
     const vec2 s = samples[base + a];
     if (abs(s.x - median) <= sigma) {
-      precise float w = 1.0 / max(s.y, pc.min_ray_angle);
+      precise float w = sdfkit_ray_weight(s.y);
       wsum += w;
       wdsum += w * s.x;
       ++kept;

@@ -15,6 +15,7 @@
 #include <glm/vec4.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -35,6 +36,7 @@ constexpr float kPeelEpsilon = 1e-6f;
 constexpr float kFrameMargin = 1.02f;
 constexpr VkFormat kLayerFormat = VK_FORMAT_R32G32_UINT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+static_assert(std::bit_cast<std::uint32_t>(SDFKIT_NO_SURFACE) == SDFKIT_NO_SURFACE_BITS);
 
 struct GpuCamera {
   glm::vec4 right, up, dir;
@@ -77,14 +79,13 @@ struct ResolvePush {
   float front_tolerance;
   std::uint32_t capacity;
 };
-// Fragment-list node: depth | facing, normal, next (fragment_list_common.glsl).
-constexpr VkDeviceSize kNodeBytes = 12;
+// Fragment-list node: depth | facing, normal, next (sdf_definition_shared.h).
+constexpr VkDeviceSize kNodeBytes = 4 * SDFKIT_NODE_WORDS;
 // The fragment-list pass's colour attachment only gives the render area (nothing reads it).
 constexpr VkFormat kListTargetFormat = VK_FORMAT_R8_UINT;
 struct GatherPush {
   std::uint32_t point_count;
   std::uint32_t max_samples;
-  float min_ray_angle;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -586,7 +587,7 @@ void DepthPeelBackend::Impl::run_lists(std::size_t n, std::uint32_t max_samples,
     hd = reset.transfer_dst(hd);
     ctr = reset.transfer_dst(ctr);
     reset.execute([&, hd, ctr](PassContext& pc) {
-      vkCmdFillBuffer(pc.cmd, pc.buffer(hd), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);  // kEndOfList
+      vkCmdFillBuffer(pc.cmd, pc.buffer(hd), 0, VK_WHOLE_SIZE, SDFKIT_END_OF_LIST);
       vkCmdFillBuffer(pc.cmd, pc.buffer(ctr), 0, VK_WHOLE_SIZE, 0);
     });
     auto list = g.add_pass("fragment_lists", PassKind::Graphics);
@@ -728,7 +729,7 @@ RawSdf DepthPeelBackend::Impl::run_gather(std::size_t n, std::uint32_t max_sampl
   p.storage_read(cnt);
   smp = p.storage_read_write(smp);
   res = p.storage_write(res);
-  const GatherPush push{static_cast<std::uint32_t>(n), max_samples, kMinRayAngle};
+  const GatherPush push{static_cast<std::uint32_t>(n), max_samples};
   p.execute([&](PassContext& pc) {
     vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gather.get());
     vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gather.layout.get(), 0, 1, &gather_set, 0, nullptr);
@@ -908,7 +909,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   const auto res = static_cast<std::uint32_t>(m.cfg.resolution);
   const ImageInfo ring_info{kLayerFormat, res, res, static_cast<std::uint32_t>(2 * m.batch)};
   const ImageInfo depth_info{kDepthFormat, res, res, static_cast<std::uint32_t>(2 * m.batch)};
-  const float cos_half = std::cos(0.5f * options.cone_degrees * static_cast<float>(M_PI) / 180.0f);
+  const float cos_half = cos_half_cone(options.cone_degrees);
   const auto corner_count = static_cast<std::uint32_t>(3 * m.drawn.size());
   const auto groups = static_cast<std::uint32_t>((n + 63) / 64);
   std::vector<PassTiming> gpu;
@@ -996,7 +997,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
         peel.sampled(rings[prev]);
         peel.vertex(pos);
         depth = peel.depth(depth, LoadOp::Clear, 1.0f);
-        rings[cur] = peel.color(rings[cur], LoadOp::Clear, VkClearColorValue{.uint32 = {0x40000000u, 0, 0, 0}});
+        rings[cur] = peel.color(rings[cur], LoadOp::Clear, VkClearColorValue{.uint32 = {SDFKIT_NO_SURFACE_BITS, 0, 0, 0}});
         peel.side_effect();  // the occlusion query
         const PeelPush pp{center_scale, static_cast<std::uint32_t>(base), first, kPeelEpsilon, 0};
         peel.execute([&, pp, prev, s, count](PassContext& pc) {

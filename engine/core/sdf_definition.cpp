@@ -28,7 +28,7 @@ std::vector<ConeRay> cone_rays(int ray_count, float cone_degrees) {
     r.local_dir = glm::vec3(static_cast<float>(sin_t * std::cos(phi)),
                             static_cast<float>(sin_t * std::sin(phi)), static_cast<float>(cos_t));
     r.theta = static_cast<float>(theta);
-    r.weight = 1.0f / std::max(r.theta, kMinRayAngle);
+    r.weight = sdfkit_ray_weight(r.theta);
   }
   return rays;
 }
@@ -50,11 +50,15 @@ glm::vec3 world_direction(const Frame& f, const ConeRay& r) {
 
 bool accept_hit(FalseHitRule rule, const glm::vec3& start_normal, const glm::vec3& dir,
                 const glm::vec3& hit_normal) {
-  switch (rule) {
-    case FalseHitRule::Paper: return glm::dot(hit_normal, start_normal) <= 0.0f;
-    case FalseHitRule::Cgal: return glm::dot(dir, hit_normal) > 0.0f;
-  }
-  return false;
+  return sdfkit_accept_hit(static_cast<std::uint32_t>(rule), start_normal, dir, hit_normal);
+}
+
+float cos_half_cone(float cone_degrees) {
+  return std::cos(0.5f * cone_degrees * static_cast<float>(M_PI) / 180.0f);
+}
+
+bool in_cone(const glm::vec3& inward_normal, const glm::vec3& dir, float cone_degrees) {
+  return sdfkit_in_cone(inward_normal, dir, cos_half_cone(cone_degrees));
 }
 
 float median_of(std::span<const float> values) {

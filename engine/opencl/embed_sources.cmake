@@ -1,9 +1,32 @@
 # Writes a C++ file defining the OpenCL program source, the given .cl files concatenated in
-# order, as one raw string literal. Run as: cmake -DOUT=<file.cpp> -DSOURCES=<a.cl;b.cl> -P ...
-# (a build step: the output lands in the build tree and is regenerated when a .cl changes).
+# order, as one raw string literal. Run as:
+#   cmake -DOUT=<file.cpp> -DSOURCES=<a.cl;b.cl> -DINCLUDE_DIR=<dir> [-DVARIABLE=<name>] -P ...
+# (a build step: the output lands in the build tree and is regenerated when a .cl or an
+# included header changes). A line `#include "path"` is replaced by the text of
+# INCLUDE_DIR/path the first time it appears (later ones are dropped: the headers are guarded
+# anyway), since a program built from a string has no include path.
+cmake_policy(SET CMP0057 NEW)
+if(NOT VARIABLE)
+  set(VARIABLE kProgramSource)
+endif()
 set(_body "")
+set(_included "")
 foreach(src IN LISTS SOURCES)
   file(READ "${src}" _text)
+  string(REGEX MATCHALL "#include \"[^\"]+\"" _includes "${_text}")
+  foreach(_inc IN LISTS _includes)
+    string(REGEX REPLACE "#include \"([^\"]+)\"" "\\1" _path "${_inc}")
+    if(NOT EXISTS "${INCLUDE_DIR}/${_path}")
+      message(FATAL_ERROR "${src}: ${INCLUDE_DIR}/${_path} not found")
+    endif()
+    if(_path IN_LIST _included)
+      string(REPLACE "${_inc}" "// (${_path} included above)" _text "${_text}")
+    else()
+      list(APPEND _included "${_path}")
+      file(READ "${INCLUDE_DIR}/${_path}" _header)
+      string(REPLACE "${_inc}" "// ---- ${_path}\n${_header}// ---- end of ${_path}" _text "${_text}")
+    endif()
+  endforeach()
   if(_text MATCHES "\\)sdfkit_cl\"")
     message(FATAL_ERROR "${src} contains the raw-string delimiter )sdfkit_cl\"")
   endif()
@@ -12,8 +35,8 @@ foreach(src IN LISTS SOURCES)
 endforeach()
 set(_cpp "// Generated from cl/*.cl by engine/opencl/embed_sources.cmake; do not edit.\n")
 string(APPEND _cpp "namespace sdfkit::cl::detail {\n")
-string(APPEND _cpp "extern const char* const kProgramSource;\n")
-string(APPEND _cpp "const char* const kProgramSource = R\"sdfkit_cl(${_body})sdfkit_cl\";\n")
+string(APPEND _cpp "extern const char* const ${VARIABLE};\n")
+string(APPEND _cpp "const char* const ${VARIABLE} = R\"sdfkit_cl(${_body})sdfkit_cl\";\n")
 string(APPEND _cpp "}  // namespace sdfkit::cl::detail\n")
 file(WRITE "${OUT}.tmp" "${_cpp}")
 file(COPY_FILE "${OUT}.tmp" "${OUT}" ONLY_IF_DIFFERENT)

@@ -4,6 +4,7 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/sdf_definition.hpp"
 
 #include <glm/common.hpp>
 #include <glm/vec4.hpp>
@@ -100,8 +101,8 @@ void set_args(cl_kernel kernel, const char* kernel_name, const Args&... args) {
 // A bundle work item traces 16 rays, so groups of 8: CGAL's hand at 4 rays (the skeleton's
 // contraction calls) 1.5 -> 0.8 ms, elephant 3.6 -> 1.9 ms; at 30 rays no change.
 constexpr std::size_t kCpuWorkGroup = 8;
-// Points per work item of trace_bundles (BUNDLE in cl/sdf_trace.cl).
-constexpr std::size_t kBundle = 16;
+// Points per work item of trace_bundles (sdf_definition_shared.h).
+constexpr std::size_t kBundle = SDFKIT_BUNDLE_WIDTH;
 
 std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m - 1) / m * m; }
 
@@ -154,7 +155,7 @@ struct OpenClBackend::Impl {
   detail::Context context;
   detail::Queue queue;
   detail::Program program;
-  detail::Kernel k_cone, k_trace, k_bundles, k_gather, k_dirs;
+  detail::Kernel k_trace, k_bundles, k_gather, k_dirs;
   bool bundles = false;  // BVH traced by trace_bundles
   std::size_t local_size = 0;  // work-group size of the trace and gather kernels (0 = driver's)
 
@@ -215,7 +216,6 @@ void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
   queue = detail::Queue(clCreateCommandQueue(context.get(), device, 0, &status));
   check(status, "creating a command queue on " + d.name);
   build_program();
-  k_cone = make_kernel("make_cone");
   k_trace = make_kernel("trace_rays");
   bundles = cfg.accel == Accel::Bvh && cfg.bvh_bundles.value_or(info.type == "CPU");
   local_size = cfg.work_group_size > 0 ? cfg.work_group_size : (info.type == "CPU" ? kCpuWorkGroup : 0);
@@ -334,17 +334,16 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
 
 void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
   if (table.get() && table_rays == rays && table_cone == cone_degrees) return;
-  table.reserve(context.get(), sizeof(cl_float4) * static_cast<std::size_t>(rays),
-                CL_MEM_READ_WRITE, "the cone's rays");
-  const double half = 0.5 * static_cast<double>(cone_degrees) * M_PI / 180.0;
-  const auto one_minus_cos = static_cast<float>(1.0 - std::cos(half));
-  // The golden angle in turns, split so that i * c_hi is exact in float for i < 2^10.
-  const double turns = kGoldenAngle / (2.0 * M_PI);
-  const double c_hi = std::round(turns * 8192.0) / 8192.0;
-  const auto f_hi = static_cast<float>(c_hi), f_lo = static_cast<float>(turns - c_hi);
-  const cl_mem t = table.get();
-  set_args(k_cone.get(), "make_cone", cl_int{rays}, one_minus_cos, f_hi, f_lo, t);
-  run(k_cone.get(), static_cast<std::size_t>(rays), 0, "make_cone");
+  // The rays of the C++ definition itself (local direction xyz, weight w), not a device copy of
+  // its formulas.
+  const std::vector<ConeRay> cone = cone_rays(rays, cone_degrees);
+  std::vector<cl_float4> rows(cone.size());
+  for (std::size_t i = 0; i < cone.size(); ++i)
+    rows[i] = {{cone[i].local_dir.x, cone[i].local_dir.y, cone[i].local_dir.z, cone[i].weight}};
+  const std::size_t bytes = rows.size() * sizeof(cl_float4);
+  table.reserve(context.get(), bytes, CL_MEM_READ_ONLY, "the cone's rays");
+  write(table.get(), bytes, rows.data(), "the cone's rays");
+  finish("uploading the cone's rays");  // `rows` goes out of scope
   table_rays = rays;
   table_cone = cone_degrees;
 }
@@ -548,6 +547,26 @@ RawSdf OpenClBackend::gather_lengths_for_test(std::span<const float> lengths,
                             raw.kept_rays.data(), 0, nullptr, nullptr),
         "reading test counts back");
   return raw;
+}
+
+std::vector<std::uint32_t> OpenClBackend::definition_probe_for_test(std::span<const glm::vec4> cases) {
+  Impl& m = *impl_;
+  if (cases.size() % 3 != 0) throw InputError("definition_probe_for_test needs three entries per case");
+  const std::size_t n = cases.size() / 3;
+  std::vector<std::uint32_t> out(n);
+  if (n == 0) return out;
+  detail::Kernel probe = m.make_kernel("definition_probe");
+  detail::Buffer in_buf, out_buf;
+  const cl_context ctx = m.context.get();
+  in_buf.reserve(ctx, cases.size() * sizeof(cl_float4), CL_MEM_READ_ONLY, "test cases");
+  out_buf.reserve(ctx, n * sizeof(cl_uint), CL_MEM_WRITE_ONLY, "test results");
+  m.write(in_buf.get(), cases.size() * sizeof(cl_float4), cases.data(), "test cases");
+  set_args(probe.get(), "definition_probe", in_buf.get(), static_cast<cl_uint>(n), out_buf.get());
+  m.run(probe.get(), n, 0, "definition_probe");
+  check(clEnqueueReadBuffer(m.queue.get(), out_buf.get(), CL_TRUE, 0, n * sizeof(cl_uint), out.data(), 0,
+                            nullptr, nullptr),
+        "reading test results back");
+  return out;
 }
 
 }  // namespace sdfkit::cl

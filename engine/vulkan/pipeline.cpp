@@ -92,8 +92,10 @@ Pipeline create_graphics_pipeline(Context& ctx, const GraphicsPipelineDescriptio
   Pipeline p;
   p.set_layout = create_set_layout(dev, d.bindings, stages);
   p.layout = make_layout(dev, p.set_layout.get(), d.push_bytes, stages);
-  UniqueShaderModule vs = create_shader_module(dev, embedded_spirv(d.vertex_shader));
-  UniqueShaderModule fs = create_shader_module(dev, embedded_spirv(d.fragment_shader));
+  UniqueShaderModule vs =
+      create_shader_module(dev, d.vertex_spirv.empty() ? embedded_spirv(d.vertex_shader) : d.vertex_spirv);
+  UniqueShaderModule fs =
+      create_shader_module(dev, d.fragment_spirv.empty() ? embedded_spirv(d.fragment_shader) : d.fragment_spirv);
   VkPipelineShaderStageCreateInfo st[2] = {
       {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, vs.get(), "main", nullptr},
       {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT, fs.get(), "main", nullptr}};

@@ -141,3 +141,16 @@ TEST(Gather, ValueLiesWithinTheKeptRangeForRandomInput) {
     EXPECT_TRUE(std::isfinite(g.value));
   }
 }
+
+TEST(InCone, DirectionsOnTheBoundaryAreInside) {
+  // cos(60 degrees) rounds to 0.49999997f in float: a direction at exactly 0.5 is inside, one
+  // at a cosine a hair below the rounded value is outside.
+  EXPECT_FLOAT_EQ(cos_half_cone(120.0f), 0.5f);
+  const glm::vec3 axis(0, 0, 1);
+  EXPECT_TRUE(in_cone(axis, glm::vec3(std::sqrt(0.75f), 0.0f, 0.5f), 120.0f));
+  EXPECT_TRUE(in_cone(axis, axis, 1.0f));
+  EXPECT_FALSE(in_cone(axis, glm::vec3(1, 0, 0), 120.0f));
+  EXPECT_TRUE(in_cone(axis, glm::vec3(0, 0, -1), 360.0f));  // cos(180) = -1: everything
+  EXPECT_EQ(sdfkit_ray_weight(0.0f), 1.0f / kMinRayAngle);
+  EXPECT_EQ(sdfkit_ray_weight(0.5f), 2.0f);
+}

@@ -1,5 +1,6 @@
 // The device's versions of the shared definition, held to the C++ one: the generated rays and
 // their weights, and the gather (median, sigma filter, weighted mean).
+#include "definition_cases.hpp"
 #include "device_fixture.hpp"
 
 #include "sdfkit/core/sdf_definition.hpp"
@@ -77,4 +78,18 @@ TEST(OpenClDefinition, DeviceGatherEqualsTheDefinition) {
       EXPECT_FLOAT_EQ(got.values[static_cast<std::size_t>(p)], want.value) << "point " << p;
     }
   }
+}
+
+TEST(OpenClDefinition, FalseHitRulesAndConeTestEqualTheDefinition) {
+  SDFKIT_REQUIRE_CL(backend);
+  const std::vector<glm::vec4> cases = test::definition_cases();
+  const std::vector<std::uint32_t> got = backend.definition_probe_for_test(cases);
+  ASSERT_EQ(got.size(), cases.size() / 3);
+  std::uint32_t seen = 0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    const std::uint32_t want = test::definition_bits(cases, i);
+    seen |= (want & 3u) == 1u ? 1u : (want & 3u) == 2u ? 2u : 0u;
+    ASSERT_EQ(got[i], want) << "case " << i;
+  }
+  EXPECT_EQ(seen, 3u) << "the cases must include hits only one rule keeps, each way";
 }

@@ -1,6 +1,7 @@
 // The engine on a real device (lavapipe in CI): context, allocator, embedded SPIR-V, one-time
 // submission, validation messages counted.
 
+#include "test_shaders.hpp"
 #include "vk_test_util.hpp"
 
 #include "sdfkit/vulkan/depth_peel.hpp"
@@ -85,7 +86,8 @@ TEST(VulkanContext, EmbeddedComputeShaderRunsValidationClean) {
   auto* src = static_cast<float*>(in.mapped());
   for (std::uint32_t i = 0; i < n; ++i) src[i] = 0.5f * static_cast<float>(i);
   const VkDescriptorType bindings[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-  Pipeline p = create_compute_pipeline(*ctx, "test_fill.comp", bindings, sizeof(std::uint32_t));
+  Pipeline p = create_compute_pipeline(*ctx, test::test_spirv("test_fill.comp"), bindings, sizeof(std::uint32_t),
+                                       "test_fill.comp");
   UniqueDescriptorPool pool = create_descriptor_pool(ctx->device(), bindings, 1);
   VkDescriptorSet set = allocate_set(ctx->device(), pool.get(), p.set_layout.get());
   const DescriptorWrite writes[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.get()},

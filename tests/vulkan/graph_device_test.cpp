@@ -1,6 +1,7 @@
 // A small real render graph on the device: a graphics pass draws into a transient image, a
 // compute pass samples it into an imported buffer; the graph derives every barrier.
 
+#include "test_shaders.hpp"
 #include "vk_test_util.hpp"
 
 #include "sdfkit/vulkan/memory.hpp"
@@ -19,11 +20,13 @@ TEST(VulkanRenderGraph, DrawThenSampleOnDevice) {
   GraphicsPipelineDescription gd;
   gd.vertex_shader = "test_triangle.vert";
   gd.fragment_shader = "test_constant.frag";
+  gd.vertex_spirv = test::test_spirv("test_triangle.vert");
+  gd.fragment_spirv = test::test_spirv("test_constant.frag");
   gd.push_bytes = 4;
   gd.color_formats = {VK_FORMAT_R32_SFLOAT};
   Pipeline draw = create_graphics_pipeline(*ctx, gd);
   const VkDescriptorType cb[] = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-  Pipeline copy = create_compute_pipeline(*ctx, "test_sample.comp", cb, 0);
+  Pipeline copy = create_compute_pipeline(*ctx, test::test_spirv("test_sample.comp"), cb, 0, "test_sample.comp");
   UniqueDescriptorPool pool = create_descriptor_pool(dev, cb, 1);
   VkDescriptorSet set = allocate_set(dev, pool.get(), copy.set_layout.get());
   UniqueSampler sampler = create_nearest_sampler(dev);

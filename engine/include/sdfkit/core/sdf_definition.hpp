@@ -15,7 +15,11 @@
 //    rays with w_j = 1 / max(theta_j, kMinRayAngle).
 //  * No accepted ray: the point has no value and is filled afterwards (see sdf.hpp).
 //
-// The GLSL and OpenCL C versions of these formulas are held to this file by tests.
+// The pieces the devices evaluate too (the false-hit rule, the cone test, the 1/theta weight and
+// the constants) are written once in sdf_definition_shared.h, which the GLSL shaders and the
+// OpenCL kernels include as well; the device versions are held to this file by tests.
+
+#include "sdfkit/core/sdf_definition_shared.h"
 
 #include <glm/vec3.hpp>
 
@@ -26,18 +30,17 @@
 namespace sdfkit {
 
 enum class FalseHitRule : std::uint32_t {
-  Paper = 0,  // drop hits whose outward normal faces the same way as the start normal
-  Cgal = 1,   // keep only hits where the ray leaves the solid
+  Paper = SDFKIT_RULE_PAPER,  // drop hits whose outward normal faces the same way as the start normal
+  Cgal = SDFKIT_RULE_CGAL,    // keep only hits where the ray leaves the solid
 };
 
 inline constexpr int kDefaultRays = 30;
 inline constexpr float kDefaultConeDegrees = 120.0f;
 // Rays start this fraction of the bounding-box diagonal inside the surface, along -n.
 inline constexpr float kOriginOffset = 1e-5f;
-// Lower bound on a ray's angle to the cone axis in the 1/theta weight (radians). Fibonacci rays
-// never come near it (theta_0 > 0.1 rad at the defaults); it only guards view-direction
-// weights of the depth-peeling backend.
-inline constexpr float kMinRayAngle = 1e-3f;
+// Lower bound on a ray's angle to the cone axis in the 1/theta weight (radians); see
+// SDFKIT_MIN_RAY_ANGLE.
+inline constexpr float kMinRayAngle = SDFKIT_MIN_RAY_ANGLE;
 // The golden angle pi * (3 - sqrt(5)) in radians.
 inline constexpr double kGoldenAngle = 2.39996322972865332;
 
@@ -66,6 +69,12 @@ glm::vec3 world_direction(const Frame& frame, const ConeRay& ray);
 // direction `dir` that started at a point with outward unit normal `start_normal`.
 bool accept_hit(FalseHitRule rule, const glm::vec3& start_normal, const glm::vec3& dir,
                 const glm::vec3& hit_normal);
+
+// True when the unit direction `dir` lies within the cone of full aperture `cone_degrees`
+// around the unit `inward_normal` (dot >= cos(aperture / 2), the cosine rounded to float as the
+// devices receive it). The depth-peeling backend keeps a camera's view of a point by this test.
+bool in_cone(const glm::vec3& inward_normal, const glm::vec3& dir, float cone_degrees);
+float cos_half_cone(float cone_degrees);
 
 // The gather of one point: accepted lengths (any order) with their weights, same length.
 struct GatherResult {

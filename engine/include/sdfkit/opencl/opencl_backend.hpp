@@ -115,6 +115,12 @@ public:
   // hit), `weights` one weight per ray index; returns the device gather's value and kept count.
   RawSdf gather_lengths_for_test(std::span<const float> lengths, std::span<const float> weights,
                                  int rays_per_point);
+  // The shared definition's false-hit rules and cone test (sdf_definition_shared.h) as the
+  // device evaluates them. `cases` holds three entries per case: the start point's outward
+  // normal (xyz) with the cosine of the cone's half-angle in w, the ray direction, the hit's
+  // outward normal. Per case: bit 0 = the Paper rule keeps the hit, bit 1 = the Cgal rule keeps
+  // it, bit 2 = the direction lies in the cone around the inward normal.
+  std::vector<std::uint32_t> definition_probe_for_test(std::span<const glm::vec4> cases);
 
 private:
   struct Impl;

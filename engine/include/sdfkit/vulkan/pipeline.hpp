@@ -43,7 +43,10 @@ Pipeline create_compute_pipeline(Context& ctx, std::span<const std::uint32_t> sp
 
 // What a graphics pipeline for dynamic rendering needs beyond its shaders.
 struct GraphicsPipelineDescription {
-  std::string_view vertex_shader, fragment_shader;
+  std::string_view vertex_shader, fragment_shader;  // embedded shaders, by file name
+  // The caller's own SPIR-V instead (entry point "main"); used when not empty. The names above
+  // then only label error messages.
+  std::span<const std::uint32_t> vertex_spirv, fragment_spirv;
   std::vector<VkDescriptorType> bindings;        // set 0
   std::uint32_t push_bytes = 0;                  // push constants for both stages
   std::vector<VkVertexInputAttributeDescription> attributes;  // binding 0
