@@ -18,18 +18,25 @@ struct ResolvedResources {
   std::vector<std::uint32_t> resource_of_version;
 };
 
-VkImage PassContext::image(ImageHandle h) const {
-  return resolved_->images[resolved_->resource_of_version.at(h.id)];
+bool pass_declares(const CompiledPass& pass, std::uint32_t version) {
+  for (const PassUse& u : pass.uses)
+    if (u.read_version == version || u.write_version == version) return true;
+  return false;
 }
-VkImageView PassContext::view(ImageHandle h) const {
-  return resolved_->views[resolved_->resource_of_version.at(h.id)];
+
+std::uint32_t PassContext::declared_resource(std::uint32_t version) const {
+  if (!pass_declares(*pass_, version)) {
+    const std::string name =
+        version < graph_->version_names.size() ? graph_->version_names[version] : std::string("<invalid handle>");
+    throw GraphError("pass '" + pass_->name + "' uses '" + name + "', which it did not declare");
+  }
+  return resolved_->resource_of_version[version];
 }
-VkBuffer PassContext::buffer(BufferHandle h) const {
-  return resolved_->buffers[resolved_->resource_of_version.at(h.id)];
-}
-const ImageInfo& PassContext::image_info(ImageHandle h) const {
-  return resolved_->infos[resolved_->resource_of_version.at(h.id)];
-}
+
+VkImage PassContext::image(ImageHandle h) const { return resolved_->images[declared_resource(h.id)]; }
+VkImageView PassContext::view(ImageHandle h) const { return resolved_->views[declared_resource(h.id)]; }
+VkBuffer PassContext::buffer(BufferHandle h) const { return resolved_->buffers[declared_resource(h.id)]; }
+const ImageInfo& PassContext::image_info(ImageHandle h) const { return resolved_->infos[declared_resource(h.id)]; }
 
 struct TransientPool::Impl {
   explicit Impl(Context& c) : ctx(c) {}
@@ -235,6 +242,8 @@ std::vector<PassTiming> GraphExecutor::run(Context& ctx, const CompiledGraph& g,
         PassContext pc;
         pc.cmd = cmd;
         pc.resolved_ = &resolved;
+        pc.graph_ = &g;
+        pc.pass_ = &p;
         p.fn(pc);
       }
       if (graphics) ctx.functions().cmd_end_rendering(cmd);

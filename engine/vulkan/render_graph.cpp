@@ -300,29 +300,41 @@ constexpr VkAccessFlags2 kWriteBits =
 
 }  // namespace
 
-CompiledGraph RenderGraph::compile() const {
-  if (!setup_errors_.empty()) throw GraphError(setup_errors_.front());
-  const std::size_t np = passes_.size();
+// The phases of compile(), in order. Each reads the declared graph (and the results of the
+// phases before it) and is a plain function of data: tests run each one without a device.
 
+void GraphCompiler::validate() const {
+  const RenderGraph& g = graph_;
+  if (!g.setup_errors_.empty()) throw GraphError(g.setup_errors_.front());
+  const auto& passes = g.passes_;
+  const auto& versions = g.versions_;
+  const auto& resources = g.resources_;
   // Reads of versions nobody writes.
-  for (const Pass& p : passes_)
+  for (const RenderGraph::Pass& p : passes)
     for (const PassUse& u : p.uses) {
       if (!uses_previous_contents(u)) continue;
-      const Version& v = versions_[u.read_version];
-      if (v.writer < 0 && !resources_[v.resource].imported)
-        throw GraphError("pass '" + p.name + "' reads '" + version_name(u.read_version) +
+      const RenderGraph::Version& v = versions[u.read_version];
+      if (v.writer < 0 && !resources[v.resource].imported)
+        throw GraphError("pass '" + p.name + "' reads '" + g.version_name(u.read_version) +
                          "' that nothing writes");
     }
+}
 
+compile_phase::Order GraphCompiler::order() const {
+  const RenderGraph& g = graph_;
+  const auto& passes = g.passes_;
+  const auto& versions = g.versions_;
+  const auto& resources = g.resources_;
+  const std::size_t np = passes.size();
   // Edges: read after write (data), write after write and write after read (ordering only).
   std::vector<std::set<std::uint32_t>> succ(np), data_pred(np);
-  std::vector<std::vector<std::uint32_t>> readers(versions_.size());
+  std::vector<std::vector<std::uint32_t>> readers(versions.size());
   for (std::uint32_t pi = 0; pi < np; ++pi)
-    for (const PassUse& u : passes_[pi].uses)
+    for (const PassUse& u : passes[pi].uses)
       if (u.write_version == UINT32_MAX || uses_previous_contents(u)) readers[u.read_version].push_back(pi);
   for (std::uint32_t pi = 0; pi < np; ++pi) {
-    for (const PassUse& u : passes_[pi].uses) {
-      const int w = versions_[u.read_version].writer;
+    for (const PassUse& u : passes[pi].uses) {
+      const int w = versions[u.read_version].writer;
       if (w >= 0 && static_cast<std::uint32_t>(w) != pi) {
         succ[w].insert(pi);
         if (uses_previous_contents(u)) data_pred[pi].insert(static_cast<std::uint32_t>(w));
@@ -337,9 +349,9 @@ CompiledGraph RenderGraph::compile() const {
   std::vector<char> live(np, 0);
   std::vector<std::uint32_t> stack;
   for (std::uint32_t pi = 0; pi < np; ++pi) {
-    bool root = passes_[pi].side_effect;
-    for (const PassUse& u : passes_[pi].uses)
-      if (u.write_version != UINT32_MAX && resources_[u.resource].imported) root = true;
+    bool root = passes[pi].side_effect;
+    for (const PassUse& u : passes[pi].uses)
+      if (u.write_version != UINT32_MAX && resources[u.resource].imported) root = true;
     if (root) {
       live[pi] = 1;
       stack.push_back(pi);
@@ -394,33 +406,55 @@ CompiledGraph RenderGraph::compile() const {
     // path[seen[cur]..] walks backwards around the loop; reverse it to execution direction.
     std::vector<std::uint32_t> loop(path.begin() + seen[cur], path.end());
     std::reverse(loop.begin(), loop.end());
-    std::string msg = "cycle detected between passes '" + passes_[loop[0]].name + "' and '" +
-                      passes_[loop.size() > 1 ? loop[1] : loop[0]].name + "'";
+    std::string msg = "cycle detected between passes '" + passes[loop[0]].name + "' and '" +
+                      passes[loop.size() > 1 ? loop[1] : loop[0]].name + "'";
     if (loop.size() > 2) {
       msg += " (";
-      for (std::uint32_t p : loop) msg += "'" + passes_[p].name + "' -> ";
-      msg += "'" + passes_[loop[0]].name + "')";
+      for (std::uint32_t p : loop) msg += "'" + passes[p].name + "' -> ";
+      msg += "'" + passes[loop[0]].name + "')";
     }
     throw GraphError(msg);
   }
-
-  CompiledGraph out;
+  compile_phase::Order out;
+  out.passes = std::move(order);
   for (std::uint32_t p = 0; p < np; ++p)
-    if (!live[p]) out.culled.push_back(passes_[p].name);
-  for (const Resource& r : resources_) out.resource_names.push_back(r.name);
-  for (std::uint32_t v = 0; v < versions_.size(); ++v) out.version_names.push_back(version_name(v));
+    if (!live[p]) out.culled.push_back(p);
+  return out;
 
+}
+
+compile_phase::Lifetimes GraphCompiler::lifetimes(const compile_phase::Order& ord) const {
+  const RenderGraph& g = graph_;
+  const auto& passes = g.passes_;
+  const auto& resources = g.resources_;
+  const std::vector<std::uint32_t>& order = ord.passes;
   // Lifetimes of logical resources over the execution order.
-  const std::size_t nr = resources_.size();
-  std::vector<int> first(nr, -1), last(nr, -1);
-  std::vector<VkFlags> usage(nr, 0);
+  const std::size_t nr = resources.size();
+  compile_phase::Lifetimes lt;
+  lt.first.assign(nr, -1);
+  lt.last.assign(nr, -1);
+  lt.usage.assign(nr, 0);
+  auto& first = lt.first;
+  auto& last = lt.last;
+  auto& usage = lt.usage;
   for (std::size_t i = 0; i < order.size(); ++i)
-    for (const PassUse& u : passes_[order[i]].uses) {
+    for (const PassUse& u : passes[order[i]].uses) {
       if (first[u.resource] < 0) first[u.resource] = static_cast<int>(i);
       last[u.resource] = static_cast<int>(i);
-      usage[u.resource] |= usage_of(u.access, resources_[u.resource].image);
+      usage[u.resource] |= usage_of(u.access, resources[u.resource].image);
     }
 
+  return lt;
+}
+
+compile_phase::Physical GraphCompiler::assign_physical(const compile_phase::Lifetimes& lt) const {
+  const RenderGraph& g = graph_;
+  const auto& resources = g.resources_;
+  const std::size_t nr = resources.size();
+  const auto& first = lt.first;
+  const auto& last = lt.last;
+  const auto& usage = lt.usage;
+  compile_phase::Physical out;
   // Physical resources: imported ones are their own; a transient reuses a physical resource of
   // the same description whose last use ended before its first use (aliasing), else a new one.
   out.physical_of.assign(nr, UINT32_MAX);
@@ -430,7 +464,7 @@ CompiledGraph RenderGraph::compile() const {
     if (first[r] >= 0) by_first.push_back(r);
   std::stable_sort(by_first.begin(), by_first.end(), [&](auto a, auto b) { return first[a] < first[b]; });
   for (std::uint32_t r : by_first) {
-    const Resource& res = resources_[r];
+    const RenderGraph::Resource& res = resources[r];
     std::uint32_t slot = UINT32_MAX;
     if (!res.imported)
       for (std::uint32_t s = 0; s < out.physical.size(); ++s) {
@@ -460,12 +494,23 @@ CompiledGraph RenderGraph::compile() const {
     out.physical_of[r] = slot;
   }
 
+  return out;
+}
+
+void GraphCompiler::derive_barriers(const compile_phase::Order& ord, const compile_phase::Physical& phys,
+                                    CompiledGraph& out) const {
+  const RenderGraph& g = graph_;
+  const auto& passes = g.passes_;
+  const auto& resources = g.resources_;
+  const std::vector<std::uint32_t>& order = ord.passes;
+  out.physical = phys.physical;
+  out.physical_of = phys.physical_of;
   // Barriers: walk the passes in order, tracking each physical resource's state.
   std::vector<TrackState> track(out.physical.size());
   for (std::uint32_t s = 0; s < out.physical.size(); ++s) {
     const PhysicalResource& ph = out.physical[s];
     if (ph.imported) {
-      const Resource& r = resources_[ph.resources[0]];
+      const RenderGraph::Resource& r = resources[ph.resources[0]];
       const AccessState& init = r.image ? r.ext_image.initial : r.ext_buffer.initial;
       track[s].write_stages = init.stages;
       track[s].write_access = init.access & kWriteBits;
@@ -476,7 +521,7 @@ CompiledGraph RenderGraph::compile() const {
   std::vector<std::uint32_t> current_resource(out.physical.size(), UINT32_MAX);
 
   for (std::uint32_t pi : order) {
-    const Pass& p = passes_[pi];
+    const RenderGraph::Pass& p = passes[pi];
     CompiledPass cp;
     cp.pass = pi;
     cp.name = p.name;
@@ -487,14 +532,14 @@ CompiledGraph RenderGraph::compile() const {
     std::map<std::uint32_t, std::vector<const PassUse*>> per_resource;
     for (const PassUse& u : p.uses) per_resource[u.resource].push_back(&u);
     for (const auto& [res, uses] : per_resource) {
-      const bool image = resources_[res].image;
+      const bool image = resources[res].image;
       AccessState need{};
       bool writes = false, reads = false;
       std::uint32_t shown_version = uses.front()->read_version;
       for (const PassUse* u : uses) {
         const AccessState s = access_state(u->access, p.kind, image);
         if (need.stages && image && s.layout != need.layout)
-          throw GraphError("pass '" + p.name + "' uses '" + resources_[res].name + "' in two layouts (" +
+          throw GraphError("pass '" + p.name + "' uses '" + resources[res].name + "' in two layouts (" +
                            layout_name(need.layout) + " and " + layout_name(s.layout) + ")");
         need.stages |= s.stages;
         need.access |= s.access;
@@ -510,13 +555,13 @@ CompiledGraph RenderGraph::compile() const {
       VkImageLayout old_layout = t.layout;
       bool discard = false;
       if (current_resource[s] != res) {
-        if (!resources_[res].imported) {
+        if (!resources[res].imported) {
           old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
           discard = true;
         }
         current_resource[s] = res;
       }
-      if (!reads && image && !resources_[res].imported) old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+      if (!reads && image && !resources[res].imported) old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
 
       bool need_barrier = false;
       AccessState src{};
@@ -539,7 +584,7 @@ CompiledGraph RenderGraph::compile() const {
       if (need_barrier) {
         Barrier b;
         b.physical = s;
-        b.resource = version_name(shown_version);
+        b.resource = g.version_name(shown_version);
         b.image = image;
         b.src = {src.stages ? src.stages : VK_PIPELINE_STAGE_2_NONE, src.access, image ? old_layout : VK_IMAGE_LAYOUT_UNDEFINED};
         b.dst = need;
@@ -573,12 +618,12 @@ CompiledGraph RenderGraph::compile() const {
   for (std::uint32_t s = 0; s < out.physical.size(); ++s) {
     const PhysicalResource& ph = out.physical[s];
     if (!ph.imported || !ph.image) continue;
-    const Resource& r = resources_[ph.resources[0]];
+    const RenderGraph::Resource& r = resources[ph.resources[0]];
     const VkImageLayout fin = r.ext_image.final_layout;
     if (fin == VK_IMAGE_LAYOUT_UNDEFINED || fin == track[s].layout) continue;
     Barrier b;
     b.physical = s;
-    b.resource = version_name(r.latest);
+    b.resource = g.version_name(r.latest);
     b.image = true;
     b.src = {track[s].write_stages | track[s].read_stages ? track[s].write_stages | track[s].read_stages
                                                           : VK_PIPELINE_STAGE_2_NONE,
@@ -586,6 +631,19 @@ CompiledGraph RenderGraph::compile() const {
     b.dst = {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, fin};
     out.final_barriers.push_back(b);
   }
+}
+
+CompiledGraph RenderGraph::compile() const {
+  const GraphCompiler c(*this);
+  c.validate();
+  const compile_phase::Order order = c.order();
+  const compile_phase::Lifetimes lifetimes = c.lifetimes(order);
+  const compile_phase::Physical physical = c.assign_physical(lifetimes);
+  CompiledGraph out;
+  for (std::uint32_t p : order.culled) out.culled.push_back(passes_[p].name);
+  for (const Resource& r : resources_) out.resource_names.push_back(r.name);
+  for (std::uint32_t v = 0; v < versions_.size(); ++v) out.version_names.push_back(version_name(v));
+  c.derive_barriers(order, physical, out);
   return out;
 }
 

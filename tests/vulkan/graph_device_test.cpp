@@ -82,3 +82,43 @@ TEST(VulkanRenderGraph, DrawThenSampleOnDevice) {
 
 }  // namespace
 }  // namespace sdfkit::vk
+
+namespace sdfkit::vk {
+namespace {
+
+// A pass may reach only the handles it declared: the buffer of another pass is refused with an
+// error naming both, while its own is handed out.
+TEST(VulkanRenderGraph, PassContextRefusesAHandleThePassDidNotDeclare) {
+  auto ctx = test::make_test_context();
+  if (!ctx) GTEST_SKIP() << "no Vulkan device";
+  Buffer mine = create_buffer(*ctx, 64, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Readback);
+  Buffer other = create_buffer(*ctx, 64, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUse::Readback);
+  TransientPool transients(*ctx);
+  for (const bool cheat : {false, true}) {
+    RenderGraph g;
+    auto a = g.import_buffer("mine", 64, {mine.get()});
+    auto b = g.import_buffer("other", 64, {other.get()});
+    auto fill = g.add_pass("fill", PassKind::Transfer);
+    a = fill.transfer_dst(a);
+    fill.execute([&, a, b, cheat](PassContext& pc) {
+      vkCmdFillBuffer(pc.cmd, pc.buffer(a), 0, VK_WHOLE_SIZE, 7u);
+      if (cheat) vkCmdFillBuffer(pc.cmd, pc.buffer(b), 0, VK_WHOLE_SIZE, 7u);
+    });
+    if (!cheat) {
+      EXPECT_NO_THROW(execute(*ctx, g.compile(), transients));
+      EXPECT_EQ(static_cast<const std::uint32_t*>(mine.mapped())[0], 7u);
+      continue;
+    }
+    try {
+      execute(*ctx, g.compile(), transients);
+      ADD_FAILURE() << "an undeclared handle was handed out";
+    } catch (const GraphError& e) {
+      EXPECT_NE(std::string(e.what()).find("pass 'fill' uses 'other#0', which it did not declare"), std::string::npos)
+          << e.what();
+    }
+  }
+  SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(*ctx);
+}
+
+}  // namespace
+}  // namespace sdfkit::vk

@@ -275,3 +275,103 @@ TEST(RenderGraph, PeelRingOrdersLayersAndPrintsBarriers) {
 
 }  // namespace
 }  // namespace sdfkit::vk
+
+namespace sdfkit::vk {
+namespace {
+
+// A chain draw -> blur -> use, an unused pass, and an out-of-order declaration: the phases one
+// by one.
+struct PhaseGraph {
+  RenderGraph g;
+  PhaseGraph() {
+    auto out = g.import_buffer("out", 64, {});
+    auto a = g.create_image("a", kColor);
+    auto b = g.create_image("b", kColor);
+    auto unused = g.create_image("unused", kColor);
+    auto draw = g.add_pass("draw", PassKind::Graphics);  // 0
+    a = draw.color(a, LoadOp::Clear);
+    auto idle = g.add_pass("idle", PassKind::Graphics);  // 1: nothing reads what it writes
+    idle.color(unused, LoadOp::Clear);
+    auto blur = g.add_pass("blur", PassKind::Graphics);  // 2
+    blur.sampled(a);
+    b = blur.color(b, LoadOp::Clear);
+    auto use = g.add_pass("use", PassKind::Compute);  // 3
+    use.sampled(b);
+    use.storage_write(out);
+  }
+};
+
+TEST(RenderGraphPhases, ValidateReportsSetupErrorsAndUnwrittenReads) {
+  PhaseGraph ok;
+  EXPECT_NO_THROW(GraphCompiler(ok.g).validate());
+  RenderGraph bad;
+  auto img = bad.create_image("img", kColor);
+  auto p = bad.add_pass("reader", PassKind::Compute);
+  p.sampled(img);
+  EXPECT_THROW(GraphCompiler(bad).validate(), GraphError);
+}
+
+TEST(RenderGraphPhases, OrderCullsUnusedPassesAndSortsByDependencies) {
+  PhaseGraph pg;
+  const compile_phase::Order o = GraphCompiler(pg.g).order();
+  EXPECT_EQ(o.passes, (std::vector<std::uint32_t>{0, 2, 3}));
+  EXPECT_EQ(o.culled, (std::vector<std::uint32_t>{1}));
+}
+
+TEST(RenderGraphPhases, LifetimesSpanFirstToLastUseInExecutionOrder) {
+  PhaseGraph pg;
+  const GraphCompiler c(pg.g);
+  const compile_phase::Lifetimes lt = c.lifetimes(c.order());
+  // Resources: out 0, a 1, b 2, unused 3; positions in the order draw 0, blur 1, use 2.
+  EXPECT_EQ(lt.first, (std::vector<int>{2, 0, 1, -1}));
+  EXPECT_EQ(lt.last, (std::vector<int>{2, 1, 2, -1}));
+  EXPECT_EQ(lt.usage[1], VkFlags{VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
+  EXPECT_EQ(lt.usage[0], VkFlags{VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
+}
+
+TEST(RenderGraphPhases, AssignPhysicalAliasesOnlyDisjointLifetimes) {
+  PhaseGraph pg;
+  const GraphCompiler c(pg.g);
+  compile_phase::Lifetimes lt = c.lifetimes(c.order());
+  compile_phase::Physical ph = c.assign_physical(lt);
+  EXPECT_NE(ph.physical_of[1], ph.physical_of[2]);  // a and b overlap in blur
+  EXPECT_EQ(ph.physical_of[3], UINT32_MAX);         // never used
+  EXPECT_TRUE(ph.physical[ph.physical_of[0]].imported);
+  // Shift b's first use past a's last: they share.
+  lt.first[2] = 2;
+  ph = c.assign_physical(lt);
+  EXPECT_EQ(ph.physical_of[1], ph.physical_of[2]);
+}
+
+TEST(RenderGraphPhases, DeriveBarriersFollowsTheOrderGiven) {
+  PhaseGraph pg;
+  const GraphCompiler c(pg.g);
+  const compile_phase::Order o = c.order();
+  const compile_phase::Physical ph = c.assign_physical(c.lifetimes(o));
+  CompiledGraph out;
+  c.derive_barriers(o, ph, out);
+  ASSERT_EQ(out.passes.size(), 3u);
+  EXPECT_EQ(out.passes[1].name, "blur");
+  // blur samples a (colour attachment -> shader read) and clears b (undefined -> attachment).
+  ASSERT_EQ(out.passes[1].barriers.size(), 2u);
+  for (const Barrier& b : out.passes[1].barriers)
+    EXPECT_EQ(b.dst.layout, b.physical == ph.physical_of[1] ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
+                                                              : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+}
+
+TEST(RenderGraphPhases, PassDeclaresOnlyTheVersionsItUses) {
+  PhaseGraph pg;
+  const CompiledGraph c = pg.g.compile();
+  const CompiledPass& blur = c.passes[1];
+  // Versions: out#0 0, a#0 1, b#0 2, unused#0 3, a#1 4 (draw), unused#1 5 (idle), b#1 6 (blur).
+  // blur reads a#1 and writes b#1 from b#0.
+  EXPECT_TRUE(pass_declares(blur, 4));
+  EXPECT_TRUE(pass_declares(blur, 2));
+  EXPECT_TRUE(pass_declares(blur, 6));
+  EXPECT_FALSE(pass_declares(blur, 0));  // out: use's
+  EXPECT_FALSE(pass_declares(blur, 1));  // a#0, drawn over by draw
+  EXPECT_FALSE(pass_declares(blur, 5));
+}
+
+}  // namespace
+}  // namespace sdfkit::vk

@@ -104,7 +104,11 @@ struct ExternalBuffer {
   AccessState initial{VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED};
 };
 
-// Given to a pass while it records.
+struct CompiledGraph;
+struct CompiledPass;
+
+// Given to a pass while it records. A pass reaches only what it declared: asking for a handle
+// (a version) that the pass did not use throws GraphError naming the pass and the version.
 class PassContext {
 public:
   VkCommandBuffer cmd = VK_NULL_HANDLE;
@@ -115,8 +119,15 @@ public:
 
 private:
   friend class GraphExecutor;
+  std::uint32_t declared_resource(std::uint32_t version) const;
   const struct ResolvedResources* resolved_ = nullptr;
+  const CompiledGraph* graph_ = nullptr;
+  const CompiledPass* pass_ = nullptr;
 };
+
+// Whether `pass` declared a use of resource version `version` (as the version it read or the
+// one it wrote): what PassContext checks.
+bool pass_declares(const CompiledPass& pass, std::uint32_t version);
 
 using PassFunction = std::function<void(PassContext&)>;
 
@@ -210,6 +221,48 @@ struct CompiledGraph {
   std::string describe() const;
 };
 
+class RenderGraph;
+
+// The phases of RenderGraph::compile(), exposed so that each can be read and tested on its own
+// (no device needed). compile() runs them in this order:
+//   validate()        setup errors, reads of versions nothing writes
+//   order()           dependencies (read after write, write after read/write), culling of passes
+//                     nothing needs, topological order (ties by declaration), cycle detection
+//   lifetimes()       first and last use of each logical resource in that order, usage flags
+//   assign_physical() imported resources keep their own; transients alias a physical resource of
+//                     the same description whose last use ended before their first use
+//   derive_barriers() walks the passes in order, tracking each physical resource's state, and
+//                     derives every barrier and layout transition, then the final layouts
+namespace compile_phase {
+struct Order {
+  std::vector<std::uint32_t> passes;  // live passes (declaration indices) in execution order
+  std::vector<std::uint32_t> culled;  // passes removed as unused, declaration order
+};
+struct Lifetimes {
+  std::vector<int> first, last;       // per logical resource: positions in Order::passes (-1 unused)
+  std::vector<VkFlags> usage;         // per logical resource: image or buffer usage flags
+};
+struct Physical {
+  std::vector<PhysicalResource> physical;
+  std::vector<std::uint32_t> physical_of;  // logical resource -> physical index (UINT32_MAX unused)
+};
+}  // namespace compile_phase
+
+class GraphCompiler {
+public:
+  explicit GraphCompiler(const RenderGraph& graph) : graph_(graph) {}
+  void validate() const;  // throws GraphError
+  compile_phase::Order order() const;  // throws GraphError on a cycle
+  compile_phase::Lifetimes lifetimes(const compile_phase::Order& order) const;
+  compile_phase::Physical assign_physical(const compile_phase::Lifetimes& lifetimes) const;
+  // Fills out.passes (with their barriers), out.final_barriers, out.physical and out.physical_of.
+  void derive_barriers(const compile_phase::Order& order, const compile_phase::Physical& physical,
+                       CompiledGraph& out) const;
+
+private:
+  const RenderGraph& graph_;
+};
+
 class RenderGraph {
 public:
   RenderGraph() = default;
@@ -224,11 +277,13 @@ public:
   // "name#version" of a handle.
   std::string version_name(std::uint32_t version) const;
 
-  // Orders, culls, derives barriers and plans transient memory. Throws GraphError.
+  // Orders, culls, derives barriers and plans transient memory (the phases of GraphCompiler).
+  // Throws GraphError.
   CompiledGraph compile() const;
 
 private:
   friend class PassBuilder;
+  friend class GraphCompiler;
   struct Resource {
     std::string name;
     bool image = false;
