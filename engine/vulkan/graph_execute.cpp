@@ -4,11 +4,46 @@
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/vulkan/context.hpp"
 #include "sdfkit/vulkan/memory.hpp"
+#include "sdfkit/vulkan/pipeline.hpp"
 #include "sdfkit/vulkan/render_graph.hpp"
 
 #include <algorithm>
 
 namespace sdfkit::vk {
+
+// Descriptor sets for one execution: pools are created as needed and all reset when the next
+// execution starts (the previous one has completed: execute() waits for the device).
+struct DescriptorAllocator {
+  VkDevice device = VK_NULL_HANDLE;
+  std::vector<UniqueDescriptorPool> pools;
+  std::size_t current = 0;
+  void reset() {
+    for (auto& p : pools) vkResetDescriptorPool(device, p.get(), 0);
+    current = 0;
+  }
+  VkDescriptorSet allocate(VkDescriptorSetLayout layout) {
+    for (;; ++current) {
+      if (current == pools.size()) {
+        const VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1024},
+                                              {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 128},
+                                              {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 256},
+                                              {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 128}};
+        VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, nullptr, 0, 256,
+                                      static_cast<std::uint32_t>(std::size(sizes)), sizes};
+        VkDescriptorPool pool = VK_NULL_HANDLE;
+        check(vkCreateDescriptorPool(device, &ci, nullptr, &pool), "creating the render graph's descriptor pool");
+        pools.emplace_back(device, pool);
+      }
+      VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, nullptr, pools[current].get(), 1,
+                                     &layout};
+      VkDescriptorSet set = VK_NULL_HANDLE;
+      const VkResult r = vkAllocateDescriptorSets(device, &ai, &set);
+      if (r == VK_SUCCESS) return set;
+      if (r != VK_ERROR_OUT_OF_POOL_MEMORY && r != VK_ERROR_FRAGMENTED_POOL)
+        check(r, "allocating a descriptor set for a render-graph pass");
+    }
+  }
+};
 
 struct ResolvedResources {
   std::vector<VkImage> images;       // per logical resource
@@ -38,6 +73,36 @@ VkImageView PassContext::view(ImageHandle h) const { return resolved_->views[dec
 VkBuffer PassContext::buffer(BufferHandle h) const { return resolved_->buffers[declared_resource(h.id)]; }
 const ImageInfo& PassContext::image_info(ImageHandle h) const { return resolved_->infos[declared_resource(h.id)]; }
 
+VkQueryPool PassContext::query_pool(QueryPoolHandle h) const {
+  if (std::find(pass_->query_pools.begin(), pass_->query_pools.end(), h.id) == pass_->query_pools.end())
+    throw GraphError("pass '" + pass_->name + "' uses a query pool it did not declare");
+  return graph_->query_pools[h.id];
+}
+
+VkDescriptorSet PassContext::descriptor_set(VkDescriptorSetLayout layout, std::initializer_list<Binding> bindings) const {
+  std::vector<DescriptorWrite> writes;
+  writes.reserve(bindings.size());
+  for (const Binding& b : bindings) {
+    DescriptorWrite w;
+    w.binding = b.binding;
+    if (b.buffer.valid()) {
+      w.buffer = buffer(b.buffer);
+      w.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      for (const PassUse& u : pass_->uses)
+        if (u.read_version == b.buffer.id && u.access == Access::Uniform) w.type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    } else {
+      w.view = view(b.image);
+      w.sampler = b.sampler;
+      w.type = b.sampler ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+      w.layout = b.sampler ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_GENERAL;
+    }
+    writes.push_back(w);
+  }
+  const VkDescriptorSet set = descriptors_->allocate(layout);
+  write_set(descriptors_->device, set, writes);
+  return set;
+}
+
 struct TransientPool::Impl {
   explicit Impl(Context& c) : ctx(c) {}
   Context& ctx;
@@ -55,9 +120,12 @@ struct TransientPool::Impl {
   std::vector<PooledBuffer> buffers;
   UniqueQueryPool timestamps;
   std::uint32_t timestamp_capacity = 0;
+  DescriptorAllocator descriptors;
 };
 
-TransientPool::TransientPool(Context& ctx) : impl_(std::make_unique<Impl>(ctx)) {}
+TransientPool::TransientPool(Context& ctx) : impl_(std::make_unique<Impl>(ctx)) {
+  impl_->descriptors.device = ctx.device();
+}
 TransientPool::~TransientPool() = default;
 std::size_t TransientPool::image_count() const { return impl_->images.size(); }
 std::size_t TransientPool::buffer_count() const { return impl_->buffers.size(); }
@@ -191,6 +259,7 @@ std::vector<PassTiming> GraphExecutor::run(Context& ctx, const CompiledGraph& g,
     tp.timestamp_capacity = qi.queryCount;
   }
   const VkQueryPool qpool = tp.timestamps.get();
+  tp.descriptors.reset();
 
   ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     if (profile) vkCmdResetQueryPool(cmd, qpool, 0, nq);
@@ -244,6 +313,7 @@ std::vector<PassTiming> GraphExecutor::run(Context& ctx, const CompiledGraph& g,
         pc.resolved_ = &resolved;
         pc.graph_ = &g;
         pc.pass_ = &p;
+        pc.descriptors_ = &tp.descriptors;
         p.fn(pc);
       }
       if (graphics) ctx.functions().cmd_end_rendering(cmd);
@@ -264,6 +334,8 @@ std::vector<PassTiming> GraphExecutor::run(Context& ctx, const CompiledGraph& g,
     host_dep.pMemoryBarriers = &to_host;
     ctx.functions().cmd_pipeline_barrier2(cmd, &host_dep);
   });
+
+  for (const auto& [history, layout] : g.history_layouts) history->layout = layout;
 
   std::vector<PassTiming> timings;
   if (profile && nq > 0) {

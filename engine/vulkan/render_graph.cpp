@@ -201,6 +201,19 @@ BufferHandle RenderGraph::import_buffer(std::string name, VkDeviceSize size, con
   return {add_resource(std::move(r))};
 }
 
+ImageHandle RenderGraph::import_history(std::string name, const ImageInfo& info, HistoryImage& history) {
+  ExternalImage e{history.image, history.view};
+  e.initial = {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, history.layout};
+  const ImageHandle h = import_image(std::move(name), info, e);
+  resources_.back().history = &history;
+  return h;
+}
+
+QueryPoolHandle RenderGraph::import_query_pool(std::string name, VkQueryPool pool) {
+  query_pools_.emplace_back(std::move(name), pool);
+  return {static_cast<std::uint32_t>(query_pools_.size() - 1)};
+}
+
 PassBuilder RenderGraph::add_pass(std::string name, PassKind kind) {
   Pass p;
   p.name = std::move(name);
@@ -277,6 +290,13 @@ void PassBuilder::indirect(BufferHandle h) { use(h.id, Access::Indirect, LoadOp:
 void PassBuilder::vertex(BufferHandle h) { use(h.id, Access::Vertex, LoadOp::Load, {}); }
 void PassBuilder::index(BufferHandle h) { use(h.id, Access::Index, LoadOp::Load, {}); }
 void PassBuilder::side_effect() { graph_->passes_[pass_].side_effect = true; }
+void PassBuilder::queries(QueryPoolHandle h) {
+  RenderGraph::Pass& p = graph_->passes_[pass_];
+  if (h.id >= graph_->query_pools_.size())
+    graph_->setup_errors_.push_back("pass '" + p.name + "' uses an invalid query pool handle");
+  p.query_pools.push_back(h.id);
+  p.side_effect = true;
+}
 void PassBuilder::execute(PassFunction fn) { graph_->passes_[pass_].fn = std::move(fn); }
 
 // ---- compile -------------------------------------------------------------------------------
@@ -344,6 +364,17 @@ compile_phase::Order GraphCompiler::order() const {
           if (r != pi) succ[r].insert(pi);
     }
   }
+
+  // Passes declaring the same query pool keep their declaration order (a reset before the
+  // queries it resets).
+  std::vector<int> last_query_user(g.query_pools_.size(), -1);
+  for (std::uint32_t pi = 0; pi < np; ++pi)
+    for (std::uint32_t q : passes[pi].query_pools) {
+      if (q >= last_query_user.size()) continue;
+      if (last_query_user[q] >= 0 && static_cast<std::uint32_t>(last_query_user[q]) != pi)
+        succ[static_cast<std::uint32_t>(last_query_user[q])].insert(pi);
+      last_query_user[q] = static_cast<int>(pi);
+    }
 
   // Culling: keep side-effect passes, writers of imported resources, and what they read from.
   std::vector<char> live(np, 0);
@@ -527,6 +558,7 @@ void GraphCompiler::derive_barriers(const compile_phase::Order& ord, const compi
     cp.name = p.name;
     cp.kind = p.kind;
     cp.uses = p.uses;
+    cp.query_pools = p.query_pools;
     cp.fn = p.fn;
     // Merge the uses of each resource by this pass.
     std::map<std::uint32_t, std::vector<const PassUse*>> per_resource;
@@ -614,6 +646,17 @@ void GraphCompiler::derive_barriers(const compile_phase::Order& ord, const compi
     out.passes.push_back(std::move(cp));
   }
 
+  // History images: the next graph starts from the layout this one leaves (after any final
+  // transition below).
+  for (std::uint32_t s = 0; s < out.physical.size(); ++s) {
+    const PhysicalResource& ph = out.physical[s];
+    if (!ph.imported || !ph.image) continue;
+    const RenderGraph::Resource& r = resources[ph.resources[0]];
+    if (!r.history) continue;
+    const VkImageLayout fin = r.ext_image.final_layout;
+    out.history_layouts.emplace_back(r.history, fin != VK_IMAGE_LAYOUT_UNDEFINED ? fin : track[s].layout);
+  }
+
   // Imported images go to their final layouts.
   for (std::uint32_t s = 0; s < out.physical.size(); ++s) {
     const PhysicalResource& ph = out.physical[s];
@@ -643,6 +686,7 @@ CompiledGraph RenderGraph::compile() const {
   for (std::uint32_t p : order.culled) out.culled.push_back(passes_[p].name);
   for (const Resource& r : resources_) out.resource_names.push_back(r.name);
   for (std::uint32_t v = 0; v < versions_.size(); ++v) out.version_names.push_back(version_name(v));
+  for (const auto& q : query_pools_) out.query_pools.push_back(q.second);
   c.derive_barriers(order, physical, out);
   return out;
 }

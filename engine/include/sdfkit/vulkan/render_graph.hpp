@@ -26,9 +26,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sdfkit::vk {
@@ -85,6 +87,12 @@ struct BufferHandle {
   std::uint32_t id = UINT32_MAX;
   bool valid() const { return id != UINT32_MAX; }
 };
+// A query pool imported into the graph (occlusion queries...). Not versioned: the passes that
+// declare one run in their declaration order.
+struct QueryPoolHandle {
+  std::uint32_t id = UINT32_MAX;
+  bool valid() const { return id != UINT32_MAX; }
+};
 
 struct ImageInfo {
   VkFormat format = VK_FORMAT_UNDEFINED;
@@ -104,6 +112,15 @@ struct ExternalBuffer {
   AccessState initial{VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED};
 };
 
+// An image whose contents live across submissions (a ring of depth-peel layers: Granite's
+// history inputs). The graph that imports it starts from the layout the previous graph left it
+// in, and execute() records the layout this graph leaves it in: no layout is kept by hand.
+struct HistoryImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;  // a 2D-array view over all layers
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;  // updated by execute()
+};
+
 struct CompiledGraph;
 struct CompiledPass;
 
@@ -116,10 +133,26 @@ public:
   VkImageView view(ImageHandle h) const;
   VkBuffer buffer(BufferHandle h) const;
   const ImageInfo& image_info(ImageHandle h) const;
+  VkQueryPool query_pool(QueryPoolHandle h) const;
+
+  // One descriptor binding of a declared resource: a buffer (storage buffer, or uniform buffer
+  // when the pass declared it so) or an image (with a sampler: combined image sampler in
+  // SHADER_READ_ONLY_OPTIMAL; without: storage image in GENERAL).
+  struct Binding {
+    std::uint32_t binding = 0;
+    BufferHandle buffer;
+    ImageHandle image;
+    VkSampler sampler = VK_NULL_HANDLE;
+  };
+  // A descriptor set of `layout` holding the given declared resources, allocated for this
+  // execution (the graph's descriptor pools are reset when the next execution starts): passes
+  // bind through their declared handles, never through sets written ahead of time.
+  VkDescriptorSet descriptor_set(VkDescriptorSetLayout layout, std::initializer_list<Binding> bindings) const;
 
 private:
   friend class GraphExecutor;
   std::uint32_t declared_resource(std::uint32_t version) const;
+  struct DescriptorAllocator* descriptors_ = nullptr;
   const struct ResolvedResources* resolved_ = nullptr;
   const CompiledGraph* graph_ = nullptr;
   const CompiledPass* pass_ = nullptr;
@@ -167,6 +200,8 @@ public:
   void indirect(BufferHandle h);
   void vertex(BufferHandle h);
   void index(BufferHandle h);
+  // A query pool the pass records queries into or resets (implies side_effect()).
+  void queries(QueryPoolHandle h);
   // Keep the pass even when nothing reads what it writes (queries, host readback...).
   void side_effect();
   void execute(PassFunction fn);
@@ -205,6 +240,7 @@ struct CompiledPass {
   PassKind kind = PassKind::Compute;
   std::vector<Barrier> barriers;  // recorded before the pass
   std::vector<PassUse> uses;
+  std::vector<std::uint32_t> query_pools;  // QueryPoolHandle ids the pass declared
   PassFunction fn;
 };
 
@@ -216,6 +252,9 @@ struct CompiledGraph {
   std::vector<std::string> resource_names;   // logical resource names
   std::vector<std::string> version_names;    // version id -> "name#v"
   std::vector<Barrier> final_barriers;   // imported resources to their final layouts
+  std::vector<VkQueryPool> query_pools;  // by QueryPoolHandle id
+  // History images and the layout this graph leaves each in (applied by execute()).
+  std::vector<std::pair<HistoryImage*, VkImageLayout>> history_layouts;
   std::size_t barrier_count() const;
   // Human-readable listing: passes in order with their barriers, resources and aliases.
   std::string describe() const;
@@ -271,6 +310,9 @@ public:
   BufferHandle create_buffer(std::string name, VkDeviceSize size);
   ImageHandle import_image(std::string name, const ImageInfo& info, const ExternalImage& external);
   BufferHandle import_buffer(std::string name, VkDeviceSize size, const ExternalBuffer& external);
+  // An image living across submissions; `history` must outlive the execution.
+  ImageHandle import_history(std::string name, const ImageInfo& info, HistoryImage& history);
+  QueryPoolHandle import_query_pool(std::string name, VkQueryPool pool);
 
   PassBuilder add_pass(std::string name, PassKind kind);
 
@@ -292,6 +334,7 @@ private:
     VkDeviceSize size = 0;
     ExternalImage ext_image;
     ExternalBuffer ext_buffer;
+    HistoryImage* history = nullptr;
     std::uint32_t latest = 0;  // latest version id
   };
   struct Version {
@@ -303,10 +346,12 @@ private:
     std::string name;
     PassKind kind = PassKind::Compute;
     std::vector<PassUse> uses;
+    std::vector<std::uint32_t> query_pools;
     bool side_effect = false;
     PassFunction fn;
   };
   std::uint32_t add_resource(Resource r);
+  std::vector<std::pair<std::string, VkQueryPool>> query_pools_;
   std::vector<Resource> resources_;
   std::vector<Version> versions_;
   std::vector<Pass> passes_;

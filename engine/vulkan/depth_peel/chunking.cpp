@@ -1,0 +1,49 @@
+// Chunking: a query whose per-point sample storage exceeds one storage buffer runs in chunks of
+// points, each rasterizing every camera again; the stage timings add up.
+#include "session.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+namespace sdfkit::vk {
+
+RawSdf DepthPeelBackend::compute_in_chunks(const SdfQuery& query, const SdfOptions& options, std::size_t per_chunk) {
+  RawSdf out;
+  out.values.reserve(query.size());
+  out.kept_rays.reserve(query.size());
+  std::vector<StageTiming> total;
+  std::size_t chunks = 0;
+  for (std::size_t begin = 0; begin < query.size(); begin += per_chunk, ++chunks) {
+    const std::size_t end = std::min(query.size(), begin + per_chunk);
+    SdfQuery part;
+    part.domain = query.domain;
+    part.origin_offset = query.origin_offset;
+    part.origins.assign(query.origins.begin() + static_cast<std::ptrdiff_t>(begin), query.origins.begin() + static_cast<std::ptrdiff_t>(end));
+    part.normals.assign(query.normals.begin() + static_cast<std::ptrdiff_t>(begin), query.normals.begin() + static_cast<std::ptrdiff_t>(end));
+    if (!query.valid.empty())
+      part.valid.assign(query.valid.begin() + static_cast<std::ptrdiff_t>(begin), query.valid.begin() + static_cast<std::ptrdiff_t>(end));
+    RawSdf r = compute(part, options);
+    out.values.insert(out.values.end(), r.values.begin(), r.values.end());
+    out.kept_rays.insert(out.kept_rays.end(), r.kept_rays.begin(), r.kept_rays.end());
+    for (const StageTiming& t : impl_->timings) {
+      auto it = std::find_if(total.begin(), total.end(), [&](const StageTiming& x) { return x.stage == t.stage; });
+      if (it == total.end())
+        total.push_back(t);
+      else if (t.stage != "upload_mesh")
+        it->milliseconds += t.milliseconds;
+    }
+  }
+  log_info("depth peeling: " + std::to_string(query.size()) + " points in " + std::to_string(chunks) +
+           " chunks (the per-point sample storage exceeds one storage buffer)");
+  impl_->timings = std::move(total);
+  return out;
+}
+
+}  // namespace sdfkit::vk
