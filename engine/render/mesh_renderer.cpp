@@ -5,6 +5,8 @@
 
 #include "sdfkit/render/figure.hpp"
 
+#include "figure_passes.hpp"
+
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/vulkan/context.hpp"
@@ -30,28 +32,17 @@ struct SoupVertex {
 };
 static_assert(sizeof(SoupVertex) == 28);
 
-struct MeshPush {
-  glm::mat4 view_projection;
-  glm::vec4 eye;
-  glm::vec4 scale;
-};
-struct OverlayPush {
-  glm::mat4 view_projection;
-  glm::vec4 viewport;
-};
 struct Segment {
   glm::vec4 a, b, color;
 };
 
-constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-const VkDescriptorType kOneStorageBuffer[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
 
 vk::Pipeline make_mesh_pipeline(vk::Context& ctx) {
   vk::GraphicsPipelineDescription d;
   d.vertex_shader = "render_mesh.vert";
   d.fragment_shader = "render_mesh.frag";
   d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-  d.push_bytes = sizeof(MeshPush);
+  d.push_bytes = sizeof(passes::MeshPush);
   d.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SoupVertex, position)},
                   {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SoupVertex, normal)},
                   {2, 0, VK_FORMAT_R32_SFLOAT, offsetof(SoupVertex, value)}};
@@ -66,7 +57,7 @@ vk::Pipeline make_overlay_pipeline(vk::Context& ctx) {
   d.vertex_shader = "render_overlay.vert";
   d.fragment_shader = "render_overlay.frag";
   d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-  d.push_bytes = sizeof(OverlayPush);
+  d.push_bytes = sizeof(passes::OverlayPush);
   d.color_formats = {kColorFormat};
   d.depth_format = kDepthFormat;
   d.depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL;  // points, drawn last, win over line ends
@@ -86,14 +77,6 @@ vk::ExternalBuffer host_written(const vk::Buffer& b) {
   e.buffer = b.get();
   e.initial = {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED};
   return e;
-}
-
-void set_view(VkCommandBuffer cmd, const SceneView& v) {
-  const VkViewport vp{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.width),
-                      static_cast<float>(v.height), 0.0f, 1.0f};
-  const VkRect2D sc{{v.x, v.y}, {static_cast<std::uint32_t>(v.width), static_cast<std::uint32_t>(v.height)}};
-  vkCmdSetViewport(cmd, 0, 1, &vp);
-  vkCmdSetScissor(cmd, 0, 1, &sc);
 }
 
 }  // namespace
@@ -181,11 +164,7 @@ MeshRenderer::MeshRenderer(vk::Context& ctx)
     : ctx_(ctx),
       mesh_pipeline_(make_mesh_pipeline(ctx)),
       overlay_pipeline_(make_overlay_pipeline(ctx)),
-      descriptor_pool_(vk::create_descriptor_pool(ctx.device(), kOneStorageBuffer, 2)),
-      transients_(ctx) {
-  mesh_set_ = vk::allocate_set(ctx.device(), descriptor_pool_.get(), mesh_pipeline_.set_layout.get());
-  overlay_set_ = vk::allocate_set(ctx.device(), descriptor_pool_.get(), overlay_pipeline_.set_layout.get());
-}
+      transients_(ctx) {}
 
 void MeshRenderer::set_mesh(const Mesh& mesh, std::span<const float> values, SdfDomain domain,
                             const ColorScale& scale) {
@@ -215,8 +194,6 @@ void MeshRenderer::set_mesh(const Mesh& mesh, std::span<const float> values, Sdf
   palette_size_ = static_cast<std::uint32_t>(palette.size());
   lo_ = scale.lo;
   hi_ = scale.hi;
-  const vk::DescriptorWrite w[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, palette_.get()}};
-  vk::write_set(ctx_.device(), mesh_set_, w);
 }
 
 void MeshRenderer::set_overlay(std::span<const std::array<glm::vec3, 2>> lines,
@@ -231,8 +208,6 @@ void MeshRenderer::set_overlay(std::span<const std::array<glm::vec3, 2>> lines,
     return;
   }
   segments_ = upload(ctx_, segs.data(), segs.size() * sizeof(Segment), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  const vk::DescriptorWrite w[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, segments_.get()}};
-  vk::write_set(ctx_.device(), overlay_set_, w);
 }
 
 vk::ImageHandle MeshRenderer::add_passes(vk::RenderGraph& graph, std::uint32_t width, std::uint32_t height,
@@ -248,45 +223,28 @@ vk::ImageHandle MeshRenderer::add_passes(vk::RenderGraph& graph, std::uint32_t w
   auto vbuf = graph.import_buffer("figure.vertices", vertices_.size, host_written(vertices_));
   auto pal = graph.import_buffer("figure.palette", palette_.size, host_written(palette_));
 
-  auto mesh = graph.add_pass("figure.mesh", vk::PassKind::Graphics);
-  color = mesh.color(color, vk::LoadOp::Clear, VkClearColorValue{{background.x, background.y, background.z, 1.0f}});
-  depth = mesh.depth(depth, vk::LoadOp::Clear, 1.0f);
-  mesh.vertex(vbuf);
-  mesh.storage_read(pal);
-  mesh.execute([this, v, vbuf](vk::PassContext& pc) {
-    vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipeline_.get());
-    vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipeline_.layout.get(), 0, 1,
-                            &mesh_set_, 0, nullptr);
-    const VkBuffer b = pc.buffer(vbuf);
-    const VkDeviceSize offset = 0;
-    vkCmdBindVertexBuffers(pc.cmd, 0, 1, &b, &offset);
-    for (const SceneView& view : v) {
-      set_view(pc.cmd, view);
-      const MeshPush push{view.view_projection, glm::vec4(view.eye, 0.0f),
-                          glm::vec4(lo_, hi_, static_cast<float>(palette_size_), 0.0f)};
-      vkCmdPushConstants(pc.cmd, mesh_pipeline_.layout.get(), kStages, 0, sizeof(push), &push);
-      vkCmdDraw(pc.cmd, vertex_count_, 1, 0, 0);
-    }
-  });
+  passes::FigureMeshPass mp;
+  mp.pipeline = &mesh_pipeline_;
+  mp.color = color;
+  mp.depth = depth;
+  mp.vertices = vbuf;
+  mp.palette = pal;
+  mp.views = v;
+  mp.vertex_count = vertex_count_;
+  mp.background = background;
+  mp.scale = glm::vec4(lo_, hi_, static_cast<float>(palette_size_), 0.0f);
+  passes::FigureOutput drawn = passes::add_figure_mesh_pass(graph, mp);
+  color = drawn.color;
 
   if (segment_count_ > 0) {
-    auto segs = graph.import_buffer("figure.skeleton", segments_.size, host_written(segments_));
-    auto overlay = graph.add_pass("figure.skeleton", vk::PassKind::Graphics);
-    color = overlay.color(color, vk::LoadOp::Load);
-    depth = overlay.depth(depth, vk::LoadOp::Clear, 1.0f);  // on top of the mesh
-    overlay.storage_read(segs);
-    overlay.execute([this, v](vk::PassContext& pc) {
-      vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, overlay_pipeline_.get());
-      vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, overlay_pipeline_.layout.get(), 0, 1,
-                              &overlay_set_, 0, nullptr);
-      for (const SceneView& view : v) {
-        set_view(pc.cmd, view);
-        const OverlayPush push{view.view_projection,
-                               glm::vec4(static_cast<float>(view.width), static_cast<float>(view.height), 0, 0)};
-        vkCmdPushConstants(pc.cmd, overlay_pipeline_.layout.get(), kStages, 0, sizeof(push), &push);
-        vkCmdDraw(pc.cmd, 6 * segment_count_, 1, 0, 0);
-      }
-    });
+    passes::FigureOverlayPass op;
+    op.pipeline = &overlay_pipeline_;
+    op.color = drawn.color;
+    op.depth = drawn.depth;
+    op.segments = graph.import_buffer("figure.skeleton", segments_.size, host_written(segments_));
+    op.views = v;
+    op.segment_count = segment_count_;
+    color = passes::add_figure_overlay_pass(graph, op).color;
   }
   return color;
 }

@@ -3,6 +3,7 @@
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/vulkan/context.hpp"
 
+#include <functional>
 #include <map>
 #include <string>
 
@@ -27,6 +28,52 @@ std::span<const std::uint32_t> embedded_spirv(std::string_view name) {
 std::vector<std::string_view> embedded_shader_names() {
   std::vector<std::string_view> out;
   for (const auto& s : detail::embedded_shaders()) out.emplace_back(s.name);
+  return out;
+}
+
+PushConstantLayout push_constant_layout(std::span<const std::uint32_t> spirv) {
+  // SPIR-V opcodes and enumerants used here (SPIR-V specification, section 3).
+  enum : std::uint32_t {
+    kOpTypeInt = 21, kOpTypeFloat = 22, kOpTypeVector = 23, kOpTypeMatrix = 24, kOpTypeStruct = 30,
+    kOpTypePointer = 32, kOpVariable = 59, kOpMemberDecorate = 72, kDecorationMatrixStride = 7,
+    kDecorationOffset = 35, kStoragePushConstant = 9
+  };
+  if (spirv.size() < 5 || spirv[0] != 0x07230203u) throw Error("not a SPIR-V module");
+  std::map<std::uint32_t, std::vector<std::uint32_t>> types;  // id -> instruction words
+  std::map<std::uint32_t, std::uint32_t> pointee;             // push-constant pointer type -> pointee
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> offset, stride;
+  std::uint32_t block = 0;
+  for (std::size_t i = 5; i < spirv.size();) {
+    const std::uint32_t count = spirv[i] >> 16, op = spirv[i] & 0xffffu;
+    if (count == 0 || i + count > spirv.size()) throw Error("malformed SPIR-V module");
+    const std::span<const std::uint32_t> w = spirv.subspan(i, count);
+    if ((op >= kOpTypeInt && op <= kOpTypeMatrix) || op == kOpTypeStruct) types[w[1]] = {w.begin(), w.end()};
+    if (op == kOpTypePointer && w[2] == kStoragePushConstant) pointee[w[1]] = w[3];
+    if (op == kOpMemberDecorate && w[3] == kDecorationOffset) offset[{w[1], w[2]}] = w[4];
+    if (op == kOpMemberDecorate && w[3] == kDecorationMatrixStride) stride[{w[1], w[2]}] = w[4];
+    if (op == kOpVariable && w[3] == kStoragePushConstant) block = pointee.at(w[1]);
+    i += count;
+  }
+  PushConstantLayout out;
+  if (block == 0) return out;
+  const std::vector<std::uint32_t>& st = types.at(block);
+  const std::function<std::uint32_t(std::uint32_t, std::uint32_t)> size_of = [&](std::uint32_t type,
+                                                                               std::uint32_t matrix_stride) {
+    const std::vector<std::uint32_t>& t = types.at(type);
+    switch (t[0] & 0xffffu) {
+      case kOpTypeInt:
+      case kOpTypeFloat: return t[2] / 8;
+      case kOpTypeVector: return t[3] * size_of(t[2], 0);
+      case kOpTypeMatrix: return t[3] * matrix_stride;
+      default: throw Error("push_constant_layout: unsupported member type in the push-constant block");
+    }
+  };
+  for (std::uint32_t m = 0; m + 2 < st.size(); ++m) out.offsets.push_back(offset.at({block, m}));
+  if (!out.offsets.empty()) {
+    const std::uint32_t last = static_cast<std::uint32_t>(out.offsets.size() - 1);
+    const auto it = stride.find({block, last});
+    out.size = out.offsets.back() + size_of(st[2 + last], it == stride.end() ? 0 : it->second);
+  }
   return out;
 }
 

@@ -107,8 +107,6 @@ public:
 private:
   vk::Context& ctx_;
   vk::Pipeline mesh_pipeline_, overlay_pipeline_;
-  vk::UniqueDescriptorPool descriptor_pool_;
-  VkDescriptorSet mesh_set_ = VK_NULL_HANDLE, overlay_set_ = VK_NULL_HANDLE;
   vk::Buffer vertices_, palette_, segments_;
   std::uint32_t vertex_count_ = 0, segment_count_ = 0, palette_size_ = 0;
   float lo_ = 0.0f, hi_ = 1.0f;

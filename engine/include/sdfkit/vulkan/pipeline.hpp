@@ -19,6 +19,16 @@ std::vector<std::string_view> embedded_shader_names();
 
 UniqueShaderModule create_shader_module(VkDevice device, std::span<const std::uint32_t> spirv);
 
+// The push-constant block of a SPIR-V module as the shader sees it (reflection of its
+// OpMemberDecorate Offset decorations): each member's byte offset in declaration order and the
+// block's size (last offset + last member's size). Empty offsets when the module has none.
+// Holds the C++ mirrors of the blocks to the GLSL (tests/vulkan/push_constants_test.cpp).
+struct PushConstantLayout {
+  std::vector<std::uint32_t> offsets;
+  std::uint32_t size = 0;
+};
+PushConstantLayout push_constant_layout(std::span<const std::uint32_t> spirv);
+
 // A pipeline with its layout and one descriptor-set layout (set 0).
 struct Pipeline {
   UniqueDescriptorSetLayout set_layout;
