@@ -375,3 +375,53 @@ TEST(RenderGraphPhases, PassDeclaresOnlyTheVersionsItUses) {
 
 }  // namespace
 }  // namespace sdfkit::vk
+
+namespace sdfkit::vk {
+namespace {
+
+// A ring layer that lives across submissions: each graph starts from the layout the previous one
+// left, and compile() says which layout this one leaves (execute() stores it), with no flag kept
+// by the caller.
+TEST(RenderGraphHistory, AHistoryImageCarriesItsLayoutFromGraphToGraph) {
+  HistoryImage layer;  // never used: UNDEFINED
+  const ImageInfo info{VK_FORMAT_R32G32_UINT, 64, 64, 2};
+  for (int submission = 0; submission < 2; ++submission) {
+    RenderGraph g;
+    auto img = g.import_history("layer", info, layer);
+    auto out = g.import_buffer("out", 64, {});
+    auto peel = g.add_pass("peel", PassKind::Graphics);
+    img = peel.color(img, LoadOp::Clear);
+    auto diam = g.add_pass("diameter", PassKind::Compute);
+    diam.sampled(img);
+    diam.storage_write(out);
+    const CompiledGraph c = g.compile();
+    const Barrier& first = c.passes[0].barriers.at(0);
+    EXPECT_EQ(first.src.layout, submission == 0 ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    ASSERT_EQ(c.history_layouts.size(), 1u);
+    EXPECT_EQ(c.history_layouts[0].first, &layer);
+    EXPECT_EQ(c.history_layouts[0].second, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    EXPECT_TRUE(c.final_barriers.empty());  // no transition at the end: the next graph starts from here
+    for (const auto& [h, l] : c.history_layouts) h->layout = l;  // what execute() does
+  }
+}
+
+// Passes declaring one query pool keep their declaration order and are never culled.
+TEST(RenderGraphQueries, QueryPassesKeepTheirOrderAndSurviveCulling) {
+  RenderGraph g;
+  const QueryPoolHandle q = g.import_query_pool("occlusion", VK_NULL_HANDLE);
+  auto reset = g.add_pass("reset", PassKind::Transfer);
+  reset.queries(q);
+  auto draw = g.add_pass("draw", PassKind::Graphics);
+  draw.color(g.create_image("unused", kColor), LoadOp::Clear);  // nothing reads it
+  draw.queries(q);
+  const CompiledGraph c = g.compile();
+  ASSERT_EQ(order_of(c), (std::vector<std::string>{"reset", "draw"}));
+  EXPECT_EQ(c.passes[1].query_pools, (std::vector<std::uint32_t>{q.id}));
+  RenderGraph bad;
+  auto p = bad.add_pass("p", PassKind::Compute);
+  p.queries(QueryPoolHandle{3});
+  EXPECT_NE(compile_error(bad).find("invalid query pool handle"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sdfkit::vk
