@@ -96,6 +96,18 @@ TEST_F(Road, RenderComputesThroughThePipelineAndReportsItsChoice) {
   EXPECT_TRUE(fs::exists(dir_ / "r.png"));
 }
 
+TEST_F(Road, TheSkeletonSaysWhatItsPerIterationRayCountDoesOnEachBackend) {
+  // Before, the 4 rays per later iteration were silently ignored on Vulkan.
+  const RunResult v = run("skeleton builtin:capsule -o " + path("v.json") +
+                          " --backend vulkan --views 16 --resolution 64 --iterations 2 --proxy-vertices 300");
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  EXPECT_NE(v.out.find("the vulkan backend casts no rays, so the 4 rays per later iteration"), std::string::npos) << v.out;
+  const RunResult c = run("skeleton builtin:capsule -o " + path("c.json") + " --rays 12 --iterations 2 --proxy-vertices 300");
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_NE(c.out.find("with the opencl SDF"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("SDF with 12 rays per point, then 4 per later iteration"), std::string::npos) << c.out;
+}
+
 TEST_F(Road, EveryUsageErrorExitsTwo) {
   const std::string mesh = sdfkit::test::data_mesh("cube-ouvert.off");
   const std::map<std::string, std::string> cases{
@@ -116,6 +128,9 @@ TEST_F(Road, EveryUsageErrorExitsTwo) {
       {"no-such-command", "subcommand"},
   };
   for (const auto& [args, what] : cases) expect_usage_error(args, what);
+  // `sdfkit bench` runs sdfkit-bench beside it, when the benchmarks were built.
+  if (fs::exists(fs::path(SDFKIT_CLI).parent_path() / "bench" / "sdfkit-bench"))
+    expect_usage_error("bench --no-such-option", "--no-such-option");
 }
 
 TEST_F(Road, ABatchRerunWithAnyOtherOptionRecomputes) {
