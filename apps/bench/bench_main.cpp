@@ -63,7 +63,11 @@ int main(int argc, char** argv) {
   app.add_option("--work-dir", work, "Where meshes and temporary files go");
   app.add_option("--json", json_out, "Write results as JSON");
   app.add_option("--markdown", md_out, "Write the Markdown table");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // help and version succeed; every usage error is 2, as in sdfkit
+  }
   o.cgal = !no_cgal;
   o.cgal_helper = self_dir() + "/sdfkit-cgal-sdf";
   if (o.cgal && !fs::exists(o.cgal_helper)) {

@@ -38,11 +38,7 @@ void add_batch_command(CLI::App& app) {
     o.format = a->format;
     o.jobs = a->jobs;
     o.force = a->force;
-    o.base.load = a->sdf.load;
-    o.base.sdf = a->sdf.sdf;
-    o.base.write = a->sdf.write;
-    o.base.smooth_rings = a->sdf.smooth;
-    o.backend = a->sdf.backend_config;
+    o.base = a->sdf.request();
     if (!a->shard.empty()) {
       const auto [i, n] = parse_shard(a->shard);
       inputs = select_shard(inputs, i, n);

@@ -133,7 +133,7 @@ void add_compare_command(CLI::App& app) {
     print_histogram(rel, a->limit);
 
     if (a->output.empty()) return;
-    if (!mesh) throw InputError("a picture needs the mesh: give --mesh");
+    if (!mesh) throw UsageError("a picture needs the mesh: give --mesh");
 #ifdef SDFKIT_CLI_HAS_RENDER
     render::RenderOptions o;
     o.views = a->views;

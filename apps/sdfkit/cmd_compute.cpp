@@ -5,16 +5,19 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <string>
 
 namespace sdfkit::cli {
 
 void add_sdf_options(CLI::App& cmd, SdfCliOptions& o, const std::string& views_flag) {
-  cmd.add_option("--backend", o.backend, "auto | vulkan | opencl (auto: Vulkan when a device exists)")
+  cmd.add_option("--backend", o.backend,
+                 "auto | vulkan | opencl (auto: a GPU backend on a GPU; without one, OpenCL over a CPU rasterizer; "
+                 "backend options narrow it: see `sdfkit devices`)")
       ->check(CLI::IsMember({"auto", "vulkan", "opencl"}, CLI::ignore_case));
   cmd.add_option("--device", o.backend_config.device,
                  "Device index or name substring (default: env SDFKIT_VK_DEVICE / SDFKIT_CL_DEVICE)");
   cmd.add_option("--per", o.per, "vertex | face")->check(CLI::IsMember({"vertex", "face"}));
-  cmd.add_option("--rays", o.sdf.rays, "Rays per point (ray casting)")->check(CLI::Range(1, 1024));
+  cmd.add_option("--rays", o.sdf.rays, "Rays per point (OpenCL ray casting; the vulkan backend's samples are its --views cameras)")->check(CLI::Range(1, 1024));
   cmd.add_option("--cone", o.sdf.cone_degrees, "Full cone aperture in degrees")->check(CLI::Range(1.0, 180.0));
   cmd.add_option("--false-hits", o.false_hits,
                  "paper: drop hits facing the start normal | cgal: keep hits where the ray leaves the solid")
@@ -47,7 +50,21 @@ void finish_sdf_options(SdfCliOptions& o) {
   o.sdf.false_hit = o.false_hits == "cgal" ? FalseHitRule::Cgal : FalseHitRule::Paper;
   o.backend_config.kind = parse_backend_kind(o.backend);
   o.write.color = !o.no_color;
-  validate_options(o.sdf);
+  validate(o.request());
+}
+
+ComputeRequest SdfCliOptions::request() const {
+  ComputeRequest r;
+  r.load = load;
+  r.sdf = sdf;
+  r.write = write;
+  r.smooth_rings = smooth;
+  r.backend = backend_config;
+  return r;
+}
+
+std::string backend_line(const ComputeReport& r) {
+  return "backend " + r.backend + " on " + r.device + (r.backend_choice.empty() ? "" : " (" + r.backend_choice + ")");
 }
 
 void add_compute_command(CLI::App& app) {
@@ -67,18 +84,10 @@ void add_compute_command(CLI::App& app) {
   add_output_options(*cmd, a->sdf, true);
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
-    ComputeRequest req;
+    ComputeRequest req = a->sdf.request();
     req.input = a->input;
     req.output = a->output;
-    req.load = a->sdf.load;
-    req.sdf = a->sdf.sdf;
-    req.write = a->sdf.write;
-    req.smooth_rings = a->sdf.smooth;
-    std::unique_ptr<SdfBackend> backend;
-    const ComputeReport r = run_compute(req, [&]() -> SdfBackend& {
-      backend = make_backend(a->sdf.backend_config);
-      return *backend;
-    });
+    const ComputeReport r = run_compute(req);
     if (!a->json.empty()) {
       const std::string text = report_to_json(r);
       io::write_file_atomically(a->json, [&](std::ostream& os) { os << text << '\n'; });
@@ -86,7 +95,7 @@ void add_compute_command(CLI::App& app) {
     if (a->quiet) return;
     std::printf("%s: %zu vertices, %zu faces (%zu welded vertices) -> %s\n", r.input.c_str(),
                 r.input_vertices, r.input_faces, r.welded_vertices, r.output.c_str());
-    std::printf("backend %s on %s\n", r.backend.c_str(), r.device.c_str());
+    std::printf("%s\n", backend_line(r).c_str());
     for (const StageTiming& s : r.stages)
       std::printf("  %-16s %10.1f ms%s\n", s.stage.c_str(), s.milliseconds, s.nested ? " (device pass, counted in its stage)" : "");
     std::printf("  %-16s %10.1f ms\n", "total", total_milliseconds(r.stages));

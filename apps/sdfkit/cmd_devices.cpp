@@ -1,5 +1,7 @@
 #include "commands.hpp"
 
+#include "sdfkit/core/error.hpp"
+
 #include <cstdio>
 
 namespace sdfkit::cli {
@@ -12,6 +14,14 @@ void add_devices_command(CLI::App& app) {
     for (const DeviceListing& d : devices) {
       std::printf("%-7s %s%s%s\n", d.backend.c_str(), d.description.c_str(),
                   d.usable ? "" : "  [unusable: ", d.usable ? "" : (d.reason + "]").c_str());
+    }
+    // What --backend auto would run (no backend options given), and why: the rule of
+    // sdfkit::choose_backend.
+    try {
+      const BackendChoice c = choose_backend(BackendConfig{}, SdfOptions{}, devices);
+      std::printf("auto    -> %s: %s\n", to_string(c.kind), c.reason.c_str());
+    } catch (const Error& e) {
+      std::printf("auto    -> none: %s\n", e.what());
     }
   });
 }

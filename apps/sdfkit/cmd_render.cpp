@@ -110,7 +110,7 @@ void add_render_command(CLI::App& app) {
     if (a->range.size() == 2) {
       o.lo = a->range[0];
       o.hi = a->range[1];
-      if (!(o.lo < o.hi)) throw InputError("--range needs LO < HI");
+      if (!(o.lo < o.hi)) throw UsageError("--range needs LO < HI");
     }
     if (!a->skeleton.empty()) read_skeleton_overlay(a->skeleton, o);
 
@@ -120,6 +120,7 @@ void add_render_command(CLI::App& app) {
     vk::Context ctx(config);
     const render::Image img = render::render_figure(ctx, r.asset.mesh, r.values, r.domain, o);
     render::write_png(a->output, img);
+    if (r.computed) std::printf("%s\n", backend_line(r.report).c_str());
     std::printf("%s: %zu %s values%s -> %s (%d x %d, %d views, %s)\n", a->input.c_str(), r.values.size(),
                 r.domain == SdfDomain::Vertex ? "vertex" : "face", r.computed ? " (computed)" : "",
                 a->output.c_str(), img.width, img.height, o.views, ctx.info().name.c_str());

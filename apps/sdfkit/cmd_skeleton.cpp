@@ -64,13 +64,16 @@ void add_skeleton_command(CLI::App& app) {
     finish_sdf_options(a->sdf);
     const std::string ext = extension_of(a->output);
     if (ext != ".json" && ext != ".obj" && ext != ".glb" && ext != ".gltf")
-      throw InputError(a->output + ": unknown skeleton output extension (expected .json, .obj, .glb or .gltf)");
-    if (a->sdf.sdf.domain != SdfDomain::Vertex) throw InputError("skeletons use the per-vertex SDF (--per vertex)");
+      throw UsageError(a->output + ": unknown skeleton output extension (expected .json, .obj, .glb or .gltf)");
+    if (a->sdf.sdf.domain != SdfDomain::Vertex) throw UsageError("skeletons use the per-vertex SDF (--per vertex)");
     const auto t0 = std::chrono::steady_clock::now();
     const io::Asset asset = load_input(a->input, a->sdf.load);
+    // The pipeline's session: the same contract and automatic choice as `sdfkit compute`; between
+    // two GPU backends OpenCL first (the SDF is recomputed at every contraction iteration).
     BackendConfig backend_config = a->sdf.backend_config;
     backend_config.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan};
-    std::unique_ptr<SdfBackend> backend = make_backend(backend_config);
+    Session session(backend_config, a->sdf.sdf);
+    SdfBackend* backend = &session.backend();
 
     skeleton::ContractionOptions contraction;
     contraction.sdf_term = !a->no_sdf_term;
@@ -79,7 +82,7 @@ void add_skeleton_command(CLI::App& app) {
     contraction.sdf = a->sdf.sdf;
     skeleton::SkeletonOptions options;
     options.sheets = !a->no_sheets;
-    const skeleton::Skeleton skel = to_input_vertices(skeleton::extract(asset.mesh, backend.get(), contraction, options), asset);
+    const skeleton::Skeleton skel = to_input_vertices(skeleton::extract(asset.mesh, backend, contraction, options), asset);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     if (ext == ".json") {
@@ -106,9 +109,16 @@ void add_skeleton_command(CLI::App& app) {
     std::printf("%s: %zu nodes (%zu in sheets), %zu curve edges, %zu sheet triangles, %d cycles -> %s\n",
                 a->input.c_str(), skel.nodes.size(), sheet_nodes, skel.edges.size(), skel.sheet_triangles.size(),
                 skeleton::cycle_count(skel), a->output.c_str());
-    std::printf("%d contraction iterations with the %s SDF on %s; reliability %.1f%% (curves alone %.1f%%); %.2f s\n",
-                skel.iterations, backend->name().c_str(), backend->device_name().c_str(), 100.0 * skel.reliability,
-                100.0 * skel.curve_reliability, seconds);
+    std::printf("%d contraction iterations with the %s SDF on %s (%s); reliability %.1f%% (curves alone %.1f%%); %.2f s\n",
+                skel.iterations, backend->name().c_str(), backend->device_name().c_str(), session.choice().reason.c_str(),
+                100.0 * skel.reliability, 100.0 * skel.curve_reliability, seconds);
+    if (session.choice().kind == BackendKind::Vulkan)
+      std::printf("every iteration's SDF used all the depth peeling's cameras (--views): the vulkan backend casts "
+                  "no rays, so the %d rays per later iteration of ray casting do not apply\n",
+                  contraction.iteration_rays);
+    else
+      std::printf("SDF with %d rays per point, then %d per later iteration\n", contraction.sdf.rays,
+                  contraction.iteration_rays > 0 ? contraction.iteration_rays : contraction.sdf.rays);
     for (const std::string& w : skel.warnings) std::fprintf(stderr, "sdfkit: warning: %s\n", w.c_str());
   });
 }

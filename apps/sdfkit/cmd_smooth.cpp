@@ -18,30 +18,41 @@ void check_png_name(const std::string& path) {
   std::string lower = path;
   std::transform(lower.begin(), lower.end(), lower.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (!lower.ends_with(".png")) throw InputError(path + ": pictures are written as PNG (use a .png name)");
+  if (!lower.ends_with(".png")) throw UsageError(path + ": pictures are written as PNG (use a .png name)");
 }
 
 ResultValues load_or_compute(const std::string& input, const SdfCliOptions* sdf, const io::LoadOptions& load) {
   ResultValues r;
+  io::Asset asset;
   if (input.starts_with("builtin:")) {
     if (!sdf) throw InputError(input + ": a generated shape holds no values");
-    r.asset = load_input(input, load);
+    asset = load_input(input, load);
   } else {
     io::FieldFile f = io::read_field(input, sdf ? io::ValuesRequired::No : io::ValuesRequired::Yes, load);
-    r.asset = std::move(f.asset);
+    asset = std::move(f.asset);
     if (!f.values.empty()) {
       r.domain = f.domain;
-      r.values = io::welded_values(r.asset, f.domain, f.values);
+      r.values = io::welded_values(asset, f.domain, f.values);
     }
   }
   if (r.values.empty()) {
-    std::unique_ptr<SdfBackend> backend = make_backend(sdf->backend_config);
-    backend->set_mesh(r.asset.mesh);
-    SdfField field = compute_sdf(*backend, r.asset.mesh, sdf->sdf);
-    r.domain = field.domain;
-    r.values = std::move(field.values);
+    // The same road as `sdfkit compute`: validation, the backend contract and choice, the
+    // session's own mesh, smoothing.
+    ComputeRequest request = sdf->request();
+    request.input = input;
+    std::unique_ptr<Session> session;
+    ComputeResult c = compute_asset(request, std::move(asset), [&]() -> Session& {
+      session = std::make_unique<Session>(request.backend, request.sdf);
+      return *session;
+    });
+    r.asset = std::move(c.asset);
+    r.domain = c.field.domain;
+    r.values = std::move(c.field.values);
+    r.report = std::move(c.report);
     r.computed = true;
+    return r;
   }
+  r.asset = std::move(asset);
   if (sdf && sdf->smooth > 0) {
     SmoothOptions so;
     so.rings = sdf->smooth;

@@ -32,14 +32,19 @@ struct SdfCliOptions {
   io::WriteOptions write;
   bool no_color = false;
   int smooth = 0;
+  // Every option above as the pipeline's request (input and output empty).
+  ComputeRequest request() const;
 };
 // How the SDF is computed: backend, device, sampling, Vulkan and OpenCL settings, welding.
 // `views_flag` names the Vulkan camera count (render uses --views for its figure).
 void add_sdf_options(CLI::App& cmd, SdfCliOptions& o, const std::string& views_flag = "--views");
 // How results are written: --normalize, --no-color, and with `smoothing` --smooth K.
 void add_output_options(CLI::App& cmd, SdfCliOptions& o, bool smoothing);
-// Resolves the parsed strings into o.sdf / o.backend_config / o.write (throws InputError).
+// Resolves the parsed strings into o.sdf / o.backend_config / o.write and validates the whole
+// request once (sdfkit::validate: throws UsageError, exit 2).
 void finish_sdf_options(SdfCliOptions& o);
+// "backend opencl on DEVICE (why it was chosen)" for run summaries.
+std::string backend_line(const ComputeReport& report);
 
 // A result's values on its welded mesh (render, compare, smooth).
 struct ResultValues {
@@ -47,9 +52,11 @@ struct ResultValues {
   SdfDomain domain = SdfDomain::Vertex;
   std::vector<float> values;  // per welded vertex or per face of asset.mesh
   bool computed = false;      // the file held no values: computed with the SDF options
+  ComputeReport report;       // when computed: the pipeline's report
 };
 // Reads a result file (read_field); with `sdf`, a file without values (or builtin:NAME) is
-// computed instead, and o.smooth > 0 smooths the values. Without `sdf`, values are required.
+// computed instead through the pipeline (compute_asset, as `sdfkit compute`), and o.smooth > 0
+// smooths the values. Without `sdf`, values are required.
 ResultValues load_or_compute(const std::string& input, const SdfCliOptions* sdf,
                              const io::LoadOptions& load = {});
 // Throws InputError unless `path` ends in .png (any case).

@@ -35,6 +35,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // CLI11 prints the message (or the help / version, which succeed); every usage error is 2.
     return app.exit(e) == 0 ? 0 : 2;
+  } catch (const sdfkit::UsageError& e) {
+    std::fprintf(stderr, "sdfkit: usage error: %s\n", e.what());
+    return 2;
   } catch (const sdfkit::Error& e) {
     std::fprintf(stderr, "sdfkit: error: %s\n", e.what());
     return 1;

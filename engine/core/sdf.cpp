@@ -11,9 +11,9 @@ namespace sdfkit {
 
 void validate_options(const SdfOptions& o) {
   if (o.rays < 1 || o.rays > 1024)
-    throw InputError("--rays must be between 1 and 1024, got " + std::to_string(o.rays));
+    throw UsageError("--rays must be between 1 and 1024, got " + std::to_string(o.rays));
   if (!(o.cone_degrees > 0.0f && o.cone_degrees <= 180.0f))
-    throw InputError("--cone must be in (0, 180] degrees, got " + std::to_string(o.cone_degrees));
+    throw UsageError("--cone must be in (0, 180] degrees, got " + std::to_string(o.cone_degrees));
 }
 
 SdfQuery make_query(const Mesh& mesh, SdfDomain domain) {

@@ -66,20 +66,6 @@ void expand_one(const std::string& input, std::set<std::string>& out, int depth)
   out.insert(fs::path(path).lexically_normal().string());
 }
 
-std::string fingerprint(const std::string& input, const BatchOptions& o) {
-  std::error_code ec;
-  const auto size = fs::file_size(input, ec);
-  const auto mtime = fs::last_write_time(input, ec).time_since_epoch().count();
-  const auto& s = o.base.sdf;
-  std::ostringstream f;
-  f << "v1 size=" << size << " mtime=" << mtime << " rays=" << s.rays << " cone=" << s.cone_degrees
-    << " per=" << (s.domain == SdfDomain::Face ? "face" : "vertex") << " hits=" << static_cast<int>(s.false_hit)
-    << " smooth=" << o.base.smooth_rings << " norm=" << o.base.write.normalized << " color=" << o.base.write.color
-    << " weld=" << o.base.load.weld_tolerance << " backend=" << to_string(o.backend.kind)
-    << " views=" << o.backend.views << " res=" << o.backend.resolution;
-  return f.str();
-}
-
 // A result is complete when its record says ok with the same fingerprint and the output exists.
 bool complete(const std::string& output, const std::string& record, const std::string& print) {
   std::error_code ec;
@@ -99,6 +85,13 @@ std::string record_path(const std::string& output) {
 
 }  // namespace
 
+std::string batch_fingerprint(const std::string& input, const BatchOptions& o) {
+  std::error_code ec;
+  const auto size = fs::file_size(input, ec);
+  const auto mtime = fs::last_write_time(input, ec).time_since_epoch().count();
+  return "v2 size=" + std::to_string(size) + " mtime=" + std::to_string(mtime) + " options=" + options_to_json(o.base);
+}
+
 std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
   std::set<std::string> out;
   for (const auto& in : inputs) expand_one(in, out, 0);
@@ -115,7 +108,7 @@ std::pair<int, int> parse_shard(const std::string& text) {
     if (a != slash || b != text.size() - slash - 1 || n < 1 || i < 0 || i >= n) throw std::invalid_argument("range");
     return {i, n};
   } catch (const std::exception&) {
-    throw InputError("--shard expects I/N with 0 <= I < N, got '" + text + "'");
+    throw UsageError("--shard expects I/N with 0 <= I < N, got '" + text + "'");
   }
 }
 
@@ -148,8 +141,14 @@ std::vector<std::string> plan_outputs(const std::vector<std::string>& inputs, co
 
 BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOptions& o, const BatchProgress& progress) {
   static const std::set<std::string> formats = {"glb", "gltf", "ply", "txt"};
-  if (!formats.count(o.format)) throw InputError("--format must be glb, gltf, ply or txt, got '" + o.format + "'");
-  if (o.jobs < 1 || o.jobs > 64) throw InputError("--jobs must be between 1 and 64");
+  if (!formats.count(o.format)) throw UsageError("--format must be glb, gltf, ply or txt, got '" + o.format + "'");
+  if (o.jobs < 1 || o.jobs > 64) throw UsageError("--jobs must be between 1 and 64");
+  {
+    ComputeRequest probe = o.base;
+    probe.output = "x." + o.format;
+    validate(probe);
+    if (o.format == "glb" || o.format == "gltf") io::check_output(probe.output, probe.sdf.domain);
+  }
   std::error_code ec;
   fs::create_directories(o.out_dir, ec);
   if (ec || !fs::is_directory(o.out_dir)) throw InputError(o.out_dir + ": cannot create the output directory");
@@ -164,7 +163,7 @@ BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOption
     a.input = inputs[i];
     a.output = outputs[i];
     a.record = record_path(outputs[i]);
-    prints[i] = fingerprint(a.input, o);
+    prints[i] = batch_fingerprint(a.input, o);
     if (!o.force && complete(a.output, a.record, prints[i])) {
       a.status = AssetStatus::Skipped;
     } else {
@@ -184,12 +183,12 @@ BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOption
 
   if (!todo.empty()) {
     // The first session is made here so that a missing device stops the batch before any work.
-    std::vector<std::unique_ptr<SdfBackend>> sessions;
-    sessions.push_back(make_backend(o.backend));
+    std::vector<std::unique_ptr<Session>> sessions;
+    sessions.push_back(std::make_unique<Session>(o.base.backend, o.base.sdf));
     const int workers = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(o.jobs), todo.size()));
-    for (int w = 1; w < workers; ++w) sessions.push_back(make_backend(o.backend));
+    for (int w = 1; w < workers; ++w) sessions.push_back(std::make_unique<Session>(o.base.backend, o.base.sdf));
     std::atomic<std::size_t> next{0};
-    auto worker = [&](SdfBackend& backend) {
+    auto worker = [&](Session& session) {
       for (std::size_t k; (k = next.fetch_add(1)) < todo.size();) {
         AssetOutcome& a = summary.assets[todo[k]];
         const std::string& print = prints[todo[k]];
@@ -201,7 +200,7 @@ BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOption
         report.input = a.input;
         report.output = a.output;
         try {
-          report = run_compute(req, backend);
+          report = run_compute(req, session);
           a.status = AssetStatus::Done;
         } catch (const std::bad_alloc&) {
           a.error = a.input + ": out of memory";

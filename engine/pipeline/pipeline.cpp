@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 namespace sdfkit {
 namespace {
@@ -64,36 +65,49 @@ FieldSummary summarize(std::span<const float> values) {
   return s;
 }
 
-ComputeReport run_compute(const ComputeRequest& request, SdfBackend& backend) {
-  return run_compute(request, [&]() -> SdfBackend& { return backend; });
+void validate(const ComputeRequest& r) {
+  validate_options(r.sdf);
+  if (r.smooth_rings < 0 || r.smooth_rings > 64)
+    throw UsageError("--smooth must be between 0 and 64 rings, got " + std::to_string(r.smooth_rings));
+  if (!(r.load.weld_tolerance >= 0.0f) || !std::isfinite(r.load.weld_tolerance))
+    throw UsageError("--weld-tolerance must be a finite number >= 0");
+  check_backend_options(r.backend.kind, r.backend, r.sdf);
 }
 
-ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& provider) {
-  validate_options(request.sdf);
-  ComputeReport report;
+namespace {
+
+// Validates, checks the output, and loads unless `preloaded`.
+ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, const SessionProvider& provider) {
+  validate(request);
+  ComputeResult out;
+  ComputeReport& report = out.report;
   report.input = request.input;
   report.output = request.output;
+  report.options = options_to_json(request);
   Stopwatch clock;
 
   // Fail on an unwritable output before spending the compute time.
   if (!request.output.empty()) io::check_output(request.output, request.sdf.domain);
 
-  io::Asset asset = load_input(request.input, request.load);
+  out.asset = preloaded ? std::move(*preloaded) : load_input(request.input, request.load);
+  const io::Asset& asset = out.asset;
   report.stages.push_back({"load", clock.lap_ms()});
   report.input_vertices = asset.input_positions.size();
   report.input_faces = asset.input_triangles.size();
   report.welded_vertices = asset.mesh.positions.size();
   report.warnings = asset.warnings;
 
-  SdfBackend& backend = provider();
-  report.backend = backend.name();
-  report.device = backend.device_name();
+  Session& session = provider();
+  report.backend = session.backend().name();
+  report.device = session.backend().device_name();
+  report.backend_choice = session.choice().reason;
   report.stages.push_back({"device", clock.lap_ms()});
-  backend.set_mesh(asset.mesh);
+  session.set_mesh(asset.mesh);
   const double set_mesh_ms = clock.lap_ms();
-  SdfField field = compute_sdf(backend, asset.mesh, request.sdf);
+  out.field = session.compute(request.sdf);
+  SdfField& field = out.field;
   const double compute_ms = clock.lap_ms();
-  const auto backend_stages = backend.last_timings();
+  const auto backend_stages = session.backend().last_timings();
   if (backend_stages.empty()) {
     report.stages.push_back({"prepare", set_mesh_ms});
     report.stages.push_back({"sdf", compute_ms});
@@ -114,12 +128,40 @@ ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& 
     report.stages.push_back({"smooth", clock.lap_ms()});
   }
   report.summary = summarize(field.values);
+  return out;
+}
 
+}  // namespace
+
+ComputeResult compute_asset(const ComputeRequest& request, const SessionProvider& provider) {
+  return compute_impl(request, nullptr, provider);
+}
+
+ComputeResult compute_asset(const ComputeRequest& request, io::Asset asset, const SessionProvider& provider) {
+  return compute_impl(request, &asset, provider);
+}
+
+ComputeReport run_compute(const ComputeRequest& request, const SessionProvider& provider) {
+  Stopwatch clock;
+  ComputeResult r = compute_asset(request, provider);
   if (!request.output.empty()) {
-    io::write_field(request.output, asset, field, request.write);
-    report.stages.push_back({"write", clock.lap_ms()});
+    clock.lap_ms();
+    io::write_field(request.output, r.asset, r.field, request.write);
+    r.report.stages.push_back({"write", clock.lap_ms()});
   }
-  return report;
+  return std::move(r.report);
+}
+
+ComputeReport run_compute(const ComputeRequest& request, Session& session) {
+  return run_compute(request, [&]() -> Session& { return session; });
+}
+
+ComputeReport run_compute(const ComputeRequest& request) {
+  std::unique_ptr<Session> session;
+  return run_compute(request, [&]() -> Session& {
+    session = std::make_unique<Session>(request.backend, request.sdf);
+    return *session;
+  });
 }
 
 }  // namespace sdfkit

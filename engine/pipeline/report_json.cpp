@@ -17,6 +17,8 @@ std::string report_to_json(const ComputeReport& r, const std::string& error, con
         {"welded_vertices", r.welded_vertices}, {"points", r.points}, {"filled_points", r.filled_points}}},
       {"backend", r.backend},
       {"device", r.device},
+      {"backend_choice", r.backend_choice},
+      {"options", r.options.empty() ? nlohmann::json(nullptr) : nlohmann::json::parse(r.options)},
       {"time_ms", stages},
       {"total_ms", total_milliseconds(r.stages)},
       {"summary",

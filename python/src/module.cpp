@@ -169,7 +169,9 @@ void bind_session(py::module_& m) {
 kept between calls, for computing the SDF of many meshes, or of one mesh whose vertices move.
 
 Session(backend="auto", device="", views=0, resolution=0, memory_cap=0)
-  backend     "auto" (Vulkan when a suitable device exists, else OpenCL), "vulkan" or "opencl"
+  backend     "auto" (a GPU backend on a GPU; without a GPU OpenCL, even when a CPU rasterizer
+              such as lavapipe offers Vulkan; views/resolution narrow it to Vulkan, memory_cap
+              to OpenCL), "vulkan" or "opencl"
   device      device index or name substring ("" = env SDFKIT_VK_DEVICE / SDFKIT_CL_DEVICE, else the best)
   views, resolution  Vulkan depth peeling: camera directions and framebuffer size (0 = defaults)
   memory_cap  OpenCL: device memory cap in bytes (0 = default)
@@ -184,6 +186,8 @@ calls on it run one at a time, with the GIL released while they compute.)doc")
            "backend"_a = "auto", "device"_a = "", "views"_a = 0, "resolution"_a = 0, "memory_cap"_a = 0)
       .def_property_readonly("name", &Session::name, "The backend's name (\"opencl\", \"vulkan\").")
       .def_property_readonly("device", &Session::device, "The device's description.")
+      .def_property_readonly("choice", &Session::choice,
+                             "Why this backend runs: \"requested\", or the automatic choice's reason.")
       .def_property_readonly("vertex_count", &Session::vertex_count, "Vertices of the current mesh (0 = none).")
       .def_property_readonly("face_count", &Session::face_count, "Faces of the current mesh (0 = none).")
       .def_property_readonly(
@@ -240,7 +244,8 @@ faces:    (F, 3) vertex indices (integers, or floats holding whole numbers), cou
 model units, finite everywhere (points without an accepted ray are filled from their neighbours;
 see last_kept_rays).
 
-rays        rays per point (>= 1)
+rays        rays per point (>= 1; ray casting: OpenCL. On a Vulkan session a value other than the
+            default is refused with InputError: its samples are its cameras, set by views)
 cone        full cone aperture in degrees, (0, 180]
 false_hits  "paper": drop hits whose normal faces the start normal; "cgal": keep only hits where
             the ray leaves the solid)doc")
@@ -267,21 +272,17 @@ void bind_functions(py::module_& m) {
         if (!(weld_tolerance >= 0.0f))
           throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
         request.load.weld_tolerance = weld_tolerance;
-        const BackendConfig config = make_config(backend, device, views, resolution, memory_cap);
-        if (session && (config.kind != BackendKind::Auto || !device.empty() || views || resolution || memory_cap))
+        request.backend = make_config(backend, device, views, resolution, memory_cap);
+        if (session && (request.backend.kind != BackendKind::Auto || !device.empty() || views || resolution || memory_cap))
           throw InputError("compute_file: pass either session or backend options (backend, device, views, "
                            "resolution, memory_cap), not both");
         ComputeReport report;
         {
           py::gil_scoped_release unlocked;
           if (session) {
-            report = session->with_backend_replacing_mesh([&](SdfBackend& b) { return run_compute(request, b); });
+            report = session->with_session([&](sdfkit::Session& s) { return run_compute(request, s); });
           } else {
-            std::unique_ptr<SdfBackend> made;
-            report = run_compute(request, [&]() -> SdfBackend& {
-              made = make_backend(config);
-              return *made;
-            });
+            report = run_compute(request);  // the session opens after the input loaded
           }
         }
         return py::dict(py::module_::import("json").attr("loads")(report_to_json(report)));
@@ -293,6 +294,7 @@ void bind_functions(py::module_& m) {
       R"doc(What `sdfkit compute INPUT -o OUTPUT` does: load, compute, optionally smooth, write
 atomically. Returns the JSON report (`sdfkit compute --json`) as a dict: input, output, ok,
 counts {input_vertices, input_faces, welded_vertices, points, filled_points}, backend, device,
+backend_choice (why that backend), options (every option of the run),
 time_ms {stage: ms}, total_ms, summary {min, median, mean, max}, warnings.
 
 input   mesh file or "builtin:NAME"; output: .glb/.gltf/.ply/.txt, or None to write nothing
@@ -358,10 +360,10 @@ median_signed (model units)}.)doc");
         py::list out;
         for (const DeviceListing& d : listing)
           out.append(py::dict("backend"_a = d.backend, "description"_a = d.description, "usable"_a = d.usable,
-                              "reason"_a = d.reason));
+                              "reason"_a = d.reason, "gpu"_a = d.gpu));
         return out;
       },
-      "Every device of every built backend: [{backend, description, usable, reason}] (`sdfkit devices`).");
+      "Every device of every built backend: [{backend, description, usable, reason, gpu}] (`sdfkit devices`).");
 
   m.def(
       "backends",

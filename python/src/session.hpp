@@ -1,12 +1,8 @@
 #pragma once
-// sdfkit.Session: one backend session (device context, compiled programs, uploaded geometry)
-// kept between calls, plus the mesh it was given (needed to build queries and fill gaps).
-// Every call takes the session's lock, so Python threads may share a session safely; callers
-// release the GIL before calling in.
+// sdfkit.Session: the engine's sdfkit::Session (backend session and the mesh it holds) behind a
+// lock, so Python threads may share a session safely; callers release the GIL before calling in.
 
-#include "sdfkit/backends.hpp"
-#include "sdfkit/core/mesh.hpp"
-#include "sdfkit/core/sdf.hpp"
+#include "sdfkit/session.hpp"
 
 #include <memory>
 #include <mutex>
@@ -17,27 +13,29 @@ namespace sdfkit::python {
 
 class Session {
 public:
-  // Opens the backend (throws DeviceError when none is usable).
+  // Opens the backend (make_backend: the contract and the automatic choice; throws UsageError
+  // for options the backend would ignore, DeviceError when none is usable).
   explicit Session(const BackendConfig& config);
 
-  std::string name() const { return backend_->name(); }
-  std::string device() const { return backend_->device_name(); }
+  std::string name() const { return session_.backend().name(); }
+  std::string device() const { return session_.backend().device_name(); }
+  std::string choice() const { return session_.choice().reason; }
 
   // Replaces the geometry. `mesh` must have passed validate_mesh.
   void set_mesh(Mesh mesh);
   // Moves the vertices of the current mesh: same count; throws InputError otherwise or for a
   // non-finite coordinate.
   void update_positions(std::vector<glm::vec3> positions);
-  // The finished (filled) field on the current mesh; throws InputError without a mesh.
+  // The finished (filled) field on the current mesh; throws InputError without a mesh,
+  // UsageError for options the backend would ignore.
   SdfField compute(const SdfOptions& options);
 
-  // Runs `job` on the backend with the lock held. The job may replace the backend's geometry
-  // (run_compute calls set_mesh), so the session forgets its mesh afterwards.
+  // Runs `job` on the engine session with the lock held (run_compute replaces its mesh).
   template <class Job>
-  auto with_backend_replacing_mesh(Job&& job) {
+  auto with_session(Job&& job) {
     const std::lock_guard lock(mutex_);
-    forget_mesh();
-    return job(*backend_);
+    kept_rays_.clear();
+    return job(session_);
   }
 
   // Stage timings (ms) of the last call: the backend's own stages plus "total", the wall time
@@ -49,12 +47,8 @@ public:
   std::size_t face_count() const;
 
 private:
-  void forget_mesh();
-
   mutable std::mutex mutex_;
-  std::unique_ptr<SdfBackend> backend_;
-  Mesh mesh_;
-  bool has_mesh_ = false;
+  sdfkit::Session session_;
   std::vector<StageTiming> timings_;
   std::vector<std::uint32_t> kept_rays_;
 };

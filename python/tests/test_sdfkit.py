@@ -393,9 +393,10 @@ class FileTest(unittest.TestCase):
         np.testing.assert_allclose(np.stack([content["vertex"][c] for c in "xyz"], axis=1), self.v,
                                    rtol=1e-6, atol=1e-7)
         np.testing.assert_array_equal(np.array(content["face"]["vertex_indices"]), self.f)
-        # The session's mesh went to compute_file: it must be given a mesh again.
-        with self.assertRaisesRegex(sdfkit.InputError, "no mesh"):
-            s.compute()
+        # compute_file gave the session the file's mesh (the same float32 mesh): the session
+        # computes on it, not on a mesh it no longer holds.
+        self.assertEqual(s.vertex_count, len(self.v))
+        np.testing.assert_allclose(s.compute(per="face", **options), per_face, rtol=1e-5)
 
     def test_asset_write_back(self):
         s = opencl_session(self)
@@ -497,6 +498,40 @@ class ErrorTest(unittest.TestCase):
             sdfkit.compute_file("builtin:sphere", None, session=s, backend="opencl")
 
 
+class RoadTest(unittest.TestCase):
+    """The engine's road: the backend contract and the automatic choice, as the CLI has them."""
+
+    def test_an_option_the_backend_would_ignore_is_refused(self):
+        with self.assertRaisesRegex(sdfkit.InputError, "--views is an option of the vulkan backend"):
+            sdfkit.Session("opencl", views=64)
+        with self.assertRaisesRegex(sdfkit.InputError, "both backends"):
+            sdfkit.Session("auto", views=64, memory_cap=1 << 20)
+        with self.assertRaisesRegex(sdfkit.InputError, "--rays is an option of the opencl backend"):
+            sdfkit.compute_file("builtin:sphere", None, backend="vulkan", rays=4)
+
+    def test_rays_on_a_vulkan_session_are_refused(self):
+        if not any(d["backend"] == "vulkan" and d["usable"] for d in sdfkit.devices()):
+            self.skipTest("no Vulkan device")
+        s = sdfkit.Session("vulkan", views=16, resolution=64)
+        v, f = icosphere(1.0, 2)
+        s.set_mesh(v, f)
+        with self.assertRaisesRegex(sdfkit.InputError, "--rays is an option of the opencl backend"):
+            s.compute(rays=4)
+        self.assertEqual(s.compute().shape, (len(v),))
+
+    def test_auto_prefers_opencl_to_a_cpu_rasterizer(self):
+        devices = sdfkit.devices()
+        if any(d["gpu"] and d["usable"] for d in devices):
+            self.skipTest("a GPU is present: the rule picks it")
+        s = sdfkit.Session()
+        self.assertEqual(s.name, "opencl")
+        if any(d["backend"] == "vulkan" and d["usable"] for d in devices):
+            self.assertIn("CPU rasterizer", s.choice)
+        report = sdfkit.compute_file("builtin:sphere", None, rays=6)
+        self.assertEqual(report["backend"], "opencl")
+        self.assertEqual(report["options"]["sdf"]["rays"], 6)
+
+
 class UtilityTest(unittest.TestCase):
     """smooth, compare, devices, version."""
 
@@ -532,7 +567,7 @@ class UtilityTest(unittest.TestCase):
         opencl_session(self)  # skips here too when no device is allowed
         listing = sdfkit.devices()
         self.assertTrue(listing)
-        self.assertEqual(set(listing[0]), {"backend", "description", "usable", "reason"})
+        self.assertEqual(set(listing[0]), {"backend", "description", "usable", "reason", "gpu"})
         self.assertTrue(any(d["backend"] == "opencl" and d["usable"] for d in listing), listing)
         self.assertIn("opencl", sdfkit.backends())
 

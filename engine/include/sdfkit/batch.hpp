@@ -21,7 +21,7 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs);
 // sorted list, so shards are disjoint, cover everything, and do not depend on the machine.
 std::vector<std::string> select_shard(const std::vector<std::string>& sorted_inputs, int index, int count);
 
-// Parses "I/N" (throws InputError).
+// Parses "I/N" (throws UsageError).
 std::pair<int, int> parse_shard(const std::string& text);
 
 struct BatchOptions {
@@ -29,8 +29,9 @@ struct BatchOptions {
   std::string format = "glb";      // output extension: glb gltf ply txt
   int jobs = 2;                    // assets in flight (each with its own backend session)
   bool force = false;              // recompute assets whose result is complete
-  ComputeRequest base;             // sdf/load/write/smooth options; input/output are set per asset
-  BackendConfig backend;
+  // Every option of the result (backend, sdf, load, write, smoothing); input and output are set
+  // per asset. Its options_to_json is the resume fingerprint, with the input's size and time.
+  ComputeRequest base;
   std::string report_name = "batch-report.json";  // final report, inside out_dir
 };
 
@@ -57,8 +58,11 @@ using BatchProgress = std::function<void(std::size_t, std::size_t, const AssetOu
 std::vector<std::string> plan_outputs(const std::vector<std::string>& inputs, const std::string& out_dir,
                                       const std::string& format);
 
-// Runs the batch. Throws DeviceError before any work when no backend can be created; a bad
-// asset is recorded as Failed and the batch goes on.
+// Runs the batch. Throws UsageError for bad options and DeviceError before any work when no
+// backend can be created; a bad asset is recorded as Failed and the batch goes on. An asset is
+// skipped as complete when its output exists and its record says ok with the same fingerprint
+// (batch_fingerprint: every option of options.base, the input's size and modification time).
+std::string batch_fingerprint(const std::string& input, const BatchOptions& options);
 BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOptions& options,
                        const BatchProgress& progress = {});
 

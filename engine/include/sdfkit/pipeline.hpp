@@ -5,6 +5,7 @@
 #include "sdfkit/backends.hpp"
 #include "sdfkit/core/sdf.hpp"
 #include "sdfkit/io/asset.hpp"
+#include "sdfkit/session.hpp"
 
 #include <functional>
 #include <string>
@@ -17,6 +18,8 @@ namespace sdfkit {
 io::Asset load_input(const std::string& path, const io::LoadOptions& options = {});
 std::string builtin_names();
 
+// One job and every option that decides its result. options_to_json() writes all of them:
+// the batch's resume fingerprint and the reports' "options" are that one serialisation.
 struct ComputeRequest {
   std::string input;
   std::string output;               // format by extension; "" = do not write
@@ -24,7 +27,17 @@ struct ComputeRequest {
   SdfOptions sdf;
   io::WriteOptions write;
   int smooth_rings = 0;             // k-ring Gaussian smoothing of the result, 0 = off
+  BackendConfig backend;            // the session run_compute opens when it is not given one
 };
+
+// The one place a request's options are validated: ranges (rays, cone, smoothing, welding) and
+// the backend contract (check_backend_options). Throws UsageError.
+void validate(const ComputeRequest& request);
+
+// Every option of `request` (not input and output) as one JSON object, keys sorted: backend
+// {kind, auto_order, device, views, resolution, peel_mode, profile, validation, memory_cap,
+// accel}, sdf {rays, cone_degrees, per, false_hits}, load {...}, write {...}, smooth_rings.
+std::string options_to_json(const ComputeRequest& request);
 
 struct FieldSummary {
   float min = 0, max = 0, mean = 0, median = 0;
@@ -35,6 +48,8 @@ struct ComputeReport {
   std::string input, output;
   std::size_t input_vertices = 0, input_faces = 0, welded_vertices = 0, points = 0;
   std::string backend, device;
+  std::string backend_choice;       // why this backend (BackendChoice::reason)
+  std::string options;              // options_to_json of the request
   std::vector<StageTiming> stages;  // load, each backend stage, smooth, write
   std::size_t filled_points = 0;    // points with no accepted ray, filled from neighbours
   FieldSummary summary;
@@ -46,13 +61,26 @@ struct ComputeReport {
 std::string report_to_json(const ComputeReport& report, const std::string& error = {},
                            const std::string& fingerprint = {});
 
-// Runs one job on an existing backend session (reused across jobs). Throws Error on failure;
-// nothing is written unless everything before the write succeeded.
-ComputeReport run_compute(const ComputeRequest& request, SdfBackend& backend);
+// The session a job runs on, asked for after the input loaded: a bad file is reported before
+// any device is opened.
+using SessionProvider = std::function<Session&()>;
 
-// The same, with the backend made on first use, after the input loaded: a bad file is reported
-// before any device is opened.
-using BackendProvider = std::function<SdfBackend&()>;
-ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& backend);
+// A job's loaded asset and finished field, not written (render, the Python module).
+struct ComputeResult {
+  ComputeReport report;
+  io::Asset asset;
+  SdfField field;                   // smoothed when request.smooth_rings > 0
+};
+ComputeResult compute_asset(const ComputeRequest& request, const SessionProvider& session);
+// The same on an asset the caller loaded already (request.input only names it in the report).
+ComputeResult compute_asset(const ComputeRequest& request, io::Asset asset, const SessionProvider& session);
+
+// Runs one job: validate, load, compute, smooth, write atomically; nothing is written unless
+// everything before the write succeeded. Throws Error on failure. On a given session (reused
+// across jobs; its mesh is replaced), through a provider, or on a session opened from
+// request.backend after the input loaded.
+ComputeReport run_compute(const ComputeRequest& request, Session& session);
+ComputeReport run_compute(const ComputeRequest& request, const SessionProvider& session);
+ComputeReport run_compute(const ComputeRequest& request);
 
 }  // namespace sdfkit

@@ -18,6 +18,13 @@ public:
   using Error::Error;
 };
 
+// Options that do not fit together or do not apply: an option the chosen backend would ignore,
+// an out-of-range value, a malformed argument. The CLI exits 2 for it (1 for other errors).
+class UsageError : public InputError {
+public:
+  using InputError::InputError;
+};
+
 // A device or platform problem: no Vulkan device, no OpenCL platform, a failed kernel build.
 class DeviceError : public Error {
 public:
