@@ -328,6 +328,10 @@ RawMesh read_ply(const std::string& path, std::string_view data) {
     fail(path, "the header declares more elements than the file's " + std::to_string(data.size()) +
                    " bytes can hold (truncated file?)");
   if (vertex_count > static_cast<std::int64_t>(UINT32_MAX)) fail(path, "too many vertices");
+  for (const PlyElement& e : h.elements) {  // LoadOptions limits
+    if (e.name == "vertex") check_vertex_count(path, static_cast<std::uint64_t>(e.count));
+    if (e.name == "face") check_triangle_count(path, static_cast<std::uint64_t>(e.count), "faces");
+  }
 
   RawMesh out;
   if (h.encoding == PlyEncoding::Ascii) {
