@@ -255,6 +255,8 @@ void read_elements(const std::string& path, const PlyHeader& h, std::int64_t ver
     if (is_face)
       out.triangles.reserve(std::min(static_cast<std::size_t>(e.count), data_bytes / 4 + 1));
 
+    // No properties: its rows hold nothing (and a huge count would loop for nothing; fuzzing).
+    if (e.properties.empty()) continue;
     const std::string what = "element '" + e.name + "'";
     auto src = make_source(what);
     if (is_vertex && quality >= 0) out.vertex_quality.resize(out.positions.size());
