@@ -14,6 +14,17 @@ if(SDFKIT_SANITIZE)
   target_link_options(sdfkit_compile_options INTERFACE -fsanitize=address,undefined)
 endif()
 
+if(SDFKIT_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "SDFKIT_FUZZ needs clang (libFuzzer): use the `fuzz` preset")
+  endif()
+  # Coverage for libFuzzer on every sdfkit target; the harnesses link the fuzzer's main.
+  target_compile_options(sdfkit_compile_options INTERFACE
+    -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer
+    -fno-sanitize-recover=undefined)
+  target_link_options(sdfkit_compile_options INTERFACE -fsanitize=address,undefined)
+endif()
+
 function(sdfkit_target_defaults target)
   target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:sdfkit_compile_options>)
 endfunction()

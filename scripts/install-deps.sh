@@ -9,6 +9,8 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 packages=(
   # toolchain
   build-essential cmake ninja-build pkg-config git python3
+  # the fuzz harnesses (CMake preset `fuzz`, scripts/fuzz.sh): clang with libFuzzer
+  clang-14 libfuzzer-14-dev
   # Vulkan: loader, headers, lavapipe (CPU driver), validation layers, shader compiler
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers glslang-tools spirv-tools vulkan-tools
   # OpenCL: ICD loader, headers, PoCL (CPU platform)

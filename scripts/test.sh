@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds with warnings as errors, and runs the whole test suite with
 # CTest: Vulkan on Mesa lavapipe, OpenCL on PoCL (CPU devices: no GPU needed). A missing
-# device fails the device tests. Then a sanitizer build (ASan + UBSan) runs the CPU tests.
+# device fails the device tests. Then a sanitizer build (ASan + UBSan) runs the CPU tests, and
+# each fuzz harness runs ~30 s on its committed corpus.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -25,4 +26,10 @@ if [ "${SDFKIT_SKIP_SANITIZE:-0}" != "1" ]; then
     -DSDFKIT_WITH_OPENCL=OFF -DSDFKIT_BUILD_BENCH=OFF
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j2 -L 'core|reference|skeleton' --timeout 600
+fi
+
+# Fuzzing: every loader and the manifest parser, SDFKIT_FUZZ_SECONDS (30) each on the committed
+# corpus, clang + ASan + UBSan (scripts/fuzz.sh; longer runs: docs/fuzzing.md).
+if [ "${SDFKIT_SKIP_FUZZ:-0}" != "1" ]; then
+  scripts/fuzz.sh "${SDFKIT_FUZZ_SECONDS:-30}"
 fi

@@ -100,6 +100,7 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--height", a->height, "Picture height in pixels")->check(CLI::Range(64, 8192));
   cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units)")
       ->check(CLI::NonNegativeNumber);
+  add_asset_options(*cmd, a->load);
   cmd->callback([a] {
     if (!a->output.empty()) check_png_name(a->output);
     std::optional<io::Asset> mesh;

@@ -35,6 +35,7 @@ void add_sdf_options(CLI::App& cmd, SdfCliOptions& o, const std::string& views_f
   cmd.add_flag("--profile", o.backend_config.profile, "Time each pass on the device");
   cmd.add_option("--weld-tolerance", o.load.weld_tolerance, "Weld positions closer than this (model units)")
       ->check(CLI::NonNegativeNumber);
+  add_asset_options(cmd, o.load);
 }
 
 void add_output_options(CLI::App& cmd, SdfCliOptions& o, bool smoothing) {

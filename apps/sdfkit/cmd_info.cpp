@@ -18,8 +18,10 @@ void add_info_command(CLI::App& app) {
   cmd->add_option("--weld-tolerance", *tolerance, "Weld positions closer than this (model units)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", *json, "Print JSON instead of text");
+  auto limits = std::make_shared<io::LoadOptions>();
+  add_asset_options(*cmd, *limits);
   cmd->callback([=] {
-    io::LoadOptions load;
+    io::LoadOptions load = *limits;
     load.weld_tolerance = *tolerance;
     const io::Asset asset = load_input(*path, load);
     const MeshReport r = analyze(asset.mesh);

@@ -83,6 +83,7 @@ void add_smooth_command(CLI::App& app) {
   cmd->add_flag("--no-color", a->no_color, "Do not write COLOR_0 / PLY colours");
   cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units)")
       ->check(CLI::NonNegativeNumber);
+  add_asset_options(*cmd, a->load);
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
   cmd->callback([a] {
     a->write.color = !a->no_color;

@@ -38,6 +38,8 @@ struct SdfCliOptions {
 // How the SDF is computed: backend, device, sampling, Vulkan and OpenCL settings, welding.
 // `views_flag` names the Vulkan camera count (render uses --views for its figure).
 void add_sdf_options(CLI::App& cmd, SdfCliOptions& o, const std::string& views_flag = "--views");
+// --allow-external-paths, --max-triangles, --max-file-size into `load` (untrusted assets).
+void add_asset_options(CLI::App& cmd, io::LoadOptions& load);
 // How results are written: --normalize, --no-color, and with `smoothing` --smooth K.
 void add_output_options(CLI::App& cmd, SdfCliOptions& o, bool smoothing);
 // Resolves the parsed strings into o.sdf / o.backend_config / o.write and validates the whole

@@ -84,7 +84,7 @@ FieldFile read_field(const std::string& path, ValuesRequired required, const Loa
     case Format::Ply: {
       // The PLY reader keeps `quality`; read the file again for it (load_asset keeps only the
       // mesh).
-      detail::RawMesh raw = detail::read_ply(path, detail::read_file(path));
+      detail::RawMesh raw = detail::read_ply(path, detail::read_file(path, options.max_file_size));
       if (!raw.vertex_quality.empty()) {
         f.values = std::move(raw.vertex_quality);
       } else if (!raw.face_quality.empty()) {

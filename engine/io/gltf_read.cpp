@@ -1,6 +1,9 @@
 // glTF 2.0 reader (.gltf with external or data-URI buffers, .glb) through tinygltf. Every
 // triangle primitive of the default scene (all root nodes when there is none) is placed by its
 // node's world transform; the parsed model is kept for write-back.
+//
+// External files (buffers, images) go through ExternalFiles, tinygltf's file-system callbacks:
+// by default a URI resolves only inside the asset's own directory (SECURITY.md).
 
 #include "gltf_model.hpp"
 #include "readers.hpp"
@@ -12,8 +15,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace sdfkit::io::detail {
@@ -30,6 +36,158 @@ bool keep_image_bytes(tinygltf::Image* image, int, std::string*, std::string*, i
 }
 
 namespace {
+
+namespace fs = std::filesystem;
+
+// True when `uri` starts with a URI scheme (RFC 3986: ALPHA *( ALPHA / DIGIT / "+" / "-" / "." )
+// then ':'), as in "http://...", "file:///..." or "C:/...".
+bool has_scheme(const std::string& uri) {
+  if (uri.empty() || !std::isalpha(static_cast<unsigned char>(uri[0]))) return false;
+  for (std::size_t i = 1; i < uri.size(); ++i) {
+    const auto c = static_cast<unsigned char>(uri[i]);
+    if (c == ':') return true;
+    if (!std::isalnum(c) && c != '+' && c != '-' && c != '.') return false;
+  }
+  return false;
+}
+
+// True when `p` is `root` or lies below it (both absolute and normal).
+bool is_within(const fs::path& p, const fs::path& root) {
+  auto r = root.begin();
+  auto q = p.begin();
+  for (; r != root.end(); ++r, ++q) {
+    if (r->empty() && std::next(r) == root.end()) break;  // root's trailing separator
+    if (q == p.end() || *q != *r) return false;
+  }
+  return true;
+}
+
+// tinygltf's file-system callbacks for one asset. tinygltf joins each external URI (percent-
+// decoded) to the base directory it is given; we give it the asset's canonical directory, so the
+// URI is what follows it. Confined (the default), a URI that is absolute, has a scheme, or
+// resolves (`..`, symbolic links: weakly_canonical) outside that directory is refused before
+// anything at its target is opened; the first refusal is kept for the error message, which is
+// the same whatever the target is (nothing about it leaks). tinygltf's fallback of trying the
+// URI against the working directory is never followed. Files past max_file_size are refused
+// before they are read.
+class ExternalFiles {
+public:
+  ExternalFiles(const std::string& asset_path, const LoadOptions& options)
+      : allow_external_(options.allow_external_paths), max_size_(options.max_file_size) {
+    std::error_code ec;
+    fs::path dir = fs::absolute(fs::path(asset_path), ec).parent_path();
+    if (!ec) root_ = fs::weakly_canonical(dir, ec);
+    if (ec || root_.empty()) root_ = dir.lexically_normal();
+    base_dir_ = root_.string();
+    prefix_ = base_dir_.empty() || base_dir_.back() == '/' ? base_dir_ : base_dir_ + "/";
+  }
+
+  tinygltf::FsCallbacks callbacks() {
+    return tinygltf::FsCallbacks{&ExternalFiles::exists, &ExternalFiles::expand,
+                                 &ExternalFiles::read, &ExternalFiles::write, this};
+  }
+  const std::string& base_dir() const { return base_dir_; }
+  // "external reference 'URI' ..." for the first refused or oversized file; "" if none.
+  const std::string& problem() const { return problem_; }
+
+private:
+  // The file a joined path stands for, or nullopt (refused: problem_ says why).
+  std::optional<fs::path> resolve(const std::string& joined) {
+    if (joined.size() <= prefix_.size() || joined.compare(0, prefix_.size(), prefix_) != 0)
+      return std::nullopt;  // tinygltf's working-directory fallback
+    const std::string uri = joined.substr(prefix_.size());
+    const fs::path as_path(uri);
+    if (allow_external_) return as_path.is_absolute() ? as_path : root_ / as_path;
+    // A NUL would cut the path the system sees short of the one checked here.
+    if (uri.find('\0') != std::string::npos) return refuse(uri, "contains a NUL character");
+    if (has_scheme(uri))
+      return refuse(uri, "has a URI scheme (only data: URIs and relative paths are read)");
+    if (as_path.is_absolute() || uri[0] == '/' || uri[0] == '\\')
+      return refuse(uri, "is an absolute path");
+    const fs::path relative = as_path.lexically_normal();
+    if (relative.empty() || *relative.begin() == "..")
+      return refuse(uri, "leaves the asset's directory");
+    std::error_code ec;
+    const fs::path resolved = fs::weakly_canonical(root_ / relative, ec);
+    if (ec) return refuse(uri, "cannot be resolved");
+    if (resolved == root_) return refuse(uri, "names the asset's directory, not a file");
+    if (!is_within(resolved, root_))
+      return refuse(uri, "leaves the asset's directory (through a symbolic link)");
+    return resolved;
+  }
+
+  // The URI as the one-line message shows it: control characters as '?'.
+  static std::string printable(const std::string& uri) {
+    std::string out = uri.substr(0, 200);
+    for (char& ch : out)
+      if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = '?';
+    return uri.size() > 200 ? out + "..." : out;
+  }
+
+  std::nullopt_t refuse(const std::string& uri, const std::string& why) {
+    if (problem_.empty())
+      problem_ = "external reference '" + printable(uri) + "' " + why +
+                 "; refused: a glTF may read only files inside its own directory "
+                 "(allow_external_paths, --allow-external-paths lifts this)";
+    return std::nullopt;
+  }
+
+  static bool exists(const std::string& joined, void* self) {
+    const std::optional<fs::path> p = static_cast<ExternalFiles*>(self)->resolve(joined);
+    std::error_code ec;
+    return p && fs::is_regular_file(*p, ec);
+  }
+
+  static std::string expand(const std::string& path, void*) { return path; }
+
+  static bool read(std::vector<unsigned char>* out, std::string* err, const std::string& joined,
+                   void* self_ptr) {
+    auto* self = static_cast<ExternalFiles*>(self_ptr);
+    const std::optional<fs::path> p = self->resolve(joined);
+    if (!p) {
+      if (err) *err = "refused";
+      return false;
+    }
+    std::ifstream in(*p, std::ios::binary);
+    if (!in) {
+      if (err) *err = "cannot open the file";
+      return false;
+    }
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    if (size < 0) {
+      if (err) *err = "cannot read the file size";
+      return false;
+    }
+    if (self->max_size_ > 0 && static_cast<std::uint64_t>(size) > self->max_size_) {
+      if (self->problem_.empty())
+        self->problem_ = "external file '" + printable(joined.substr(self->prefix_.size())) +
+                         "' has " + std::to_string(size) + " bytes, more than the limit of " +
+                         std::to_string(self->max_size_) + " (max_file_size, --max-file-size)";
+      if (err) *err = "too large";
+      return false;
+    }
+    in.seekg(0, std::ios::beg);
+    out->resize(static_cast<std::size_t>(size));
+    if (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), size)) {
+      if (err) *err = "cannot read the file";
+      return false;
+    }
+    return true;
+  }
+
+  static bool write(std::string* err, const std::string&, const std::vector<unsigned char>&,
+                    void*) {
+    if (err) *err = "sdfkit's glTF reader writes no files";
+    return false;
+  }
+
+  bool allow_external_;
+  std::uint64_t max_size_;
+  fs::path root_;
+  std::string base_dir_, prefix_;
+  std::string problem_;
+};
 
 // First non-empty line of a tinygltf message, trimmed.
 std::string first_line(const std::string& text) {
@@ -345,6 +503,17 @@ private:
     }
     const std::string where =
         "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(prim_index);
+    // Limits before reading: a mesh drawn by many nodes is counted once per node.
+    {
+      const std::uint64_t vertices = reader_.accessor(pos_it->second, "POSITION").count;
+      const std::uint64_t corners =
+          prim.indices >= 0 ? reader_.accessor(prim.indices, "index").count : vertices;
+      const std::uint64_t triangles = mode == TINYGLTF_MODE_TRIANGLES ? corners / 3
+                                      : corners >= 2                  ? corners - 2
+                                                                      : 0;
+      check_vertex_count(path_, out_.positions.size() + vertices);
+      check_triangle_count(path_, out_.triangles.size() + triangles);
+    }
     const std::vector<float> xyz = reader_.floats(pos_it->second, 3, "POSITION");
     const std::size_t count = xyz.size() / 3;
     if (count == 0) {
@@ -405,14 +574,27 @@ private:
 
 }  // namespace
 
-RawMesh read_gltf(const std::string& path, bool binary) {
+RawMesh read_gltf(const std::string& path, std::string_view data, bool binary,
+                  const LoadOptions& options) {
   auto source = std::make_shared<GltfSource>();
+  ExternalFiles files(path, options);
   tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks(files.callbacks());
   loader.SetImageLoader(&keep_image_bytes, nullptr);
   loader.SetPreserveImageChannels(true);
+  if (data.empty()) fail(path, "invalid glTF: the file is empty");
+  if (data.size() > UINT32_MAX) fail(path, "invalid glTF: larger than 4 GiB");
   std::string err, warn;
-  const bool ok = binary ? loader.LoadBinaryFromFile(&source->model, &err, &warn, path)
-                         : loader.LoadASCIIFromFile(&source->model, &err, &warn, path);
+  const bool ok =
+      binary ? loader.LoadBinaryFromMemory(&source->model, &err, &warn,
+                                           reinterpret_cast<const unsigned char*>(data.data()),
+                                           static_cast<unsigned int>(data.size()),
+                                           files.base_dir())
+             : loader.LoadASCIIFromString(&source->model, &err, &warn, data.data(),
+                                          static_cast<unsigned int>(data.size()),
+                                          files.base_dir());
+  // A refused reference fails the load even where tinygltf only warns (images).
+  if (!files.problem().empty()) fail(path, files.problem());
   if (!ok) {
     std::string problem = first_line(err);
     if (problem.empty()) problem = first_line(warn);

@@ -57,6 +57,8 @@ RawMesh read_off(const std::string& path, std::string_view data) {
                    " faces, more than the file's " + std::to_string(data.size()) +
                    " bytes can hold (truncated file?)");
   if (nv > static_cast<std::int64_t>(UINT32_MAX)) fail(path, "too many vertices");
+  check_vertex_count(path, static_cast<std::uint64_t>(nv));            // LoadOptions limits
+  check_triangle_count(path, static_cast<std::uint64_t>(nf), "faces");
 
   RawMesh out;
   out.positions.resize(static_cast<std::size_t>(nv));

@@ -255,6 +255,8 @@ void read_elements(const std::string& path, const PlyHeader& h, std::int64_t ver
     if (is_face)
       out.triangles.reserve(std::min(static_cast<std::size_t>(e.count), data_bytes / 4 + 1));
 
+    // No properties: its rows hold nothing (and a huge count would loop for nothing; fuzzing).
+    if (e.properties.empty()) continue;
     const std::string what = "element '" + e.name + "'";
     auto src = make_source(what);
     if (is_vertex && quality >= 0) out.vertex_quality.resize(out.positions.size());
@@ -328,6 +330,10 @@ RawMesh read_ply(const std::string& path, std::string_view data) {
     fail(path, "the header declares more elements than the file's " + std::to_string(data.size()) +
                    " bytes can hold (truncated file?)");
   if (vertex_count > static_cast<std::int64_t>(UINT32_MAX)) fail(path, "too many vertices");
+  for (const PlyElement& e : h.elements) {  // LoadOptions limits
+    if (e.name == "vertex") check_vertex_count(path, static_cast<std::uint64_t>(e.count));
+    if (e.name == "face") check_triangle_count(path, static_cast<std::uint64_t>(e.count), "faces");
+  }
 
   RawMesh out;
   if (h.encoding == PlyEncoding::Ascii) {

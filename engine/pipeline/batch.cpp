@@ -30,7 +30,10 @@ bool is_manifest(const std::string& s) {
   return ext == ".list" || ext == ".manifest" || ext == ".txt";  // .txt is no mesh input format
 }
 
-void expand_one(const std::string& input, std::set<std::string>& out, int depth) {
+// `manifests`: those already expanded; one listed again (by itself, or twice) adds nothing new,
+// so it is read once: a manifest naming itself N times stays linear, not N^depth.
+void expand_one(const std::string& input, std::set<std::string>& out, std::set<std::string>& manifests,
+                int depth) {
   if (depth > 8) throw InputError(input + ": manifests nest too deeply");
   std::string path = input;
   bool manifest = is_manifest(path);
@@ -49,6 +52,7 @@ void expand_one(const std::string& input, std::set<std::string>& out, int depth)
     return;
   }
   if (manifest) {
+    if (!manifests.insert(fs::weakly_canonical(path, ec).string()).second) return;
     std::ifstream f(path);
     if (!f) throw InputError(path + ": cannot read the manifest");
     const fs::path base = fs::path(path).parent_path();
@@ -59,7 +63,7 @@ void expand_one(const std::string& input, std::set<std::string>& out, int depth)
       const auto e = line.find_last_not_of(" \t\r");
       fs::path p = line.substr(b, e - b + 1);
       if (p.is_relative()) p = base / p;
-      expand_one(p.lexically_normal().string(), out, depth + 1);
+      expand_one(p.lexically_normal().string(), out, manifests, depth + 1);
     }
     return;
   }
@@ -93,8 +97,8 @@ std::string batch_fingerprint(const std::string& input, const BatchOptions& o) {
 }
 
 std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
-  std::set<std::string> out;
-  for (const auto& in : inputs) expand_one(in, out, 0);
+  std::set<std::string> out, manifests;
+  for (const auto& in : inputs) expand_one(in, out, manifests, 0);
   return {out.begin(), out.end()};
 }
 

@@ -150,18 +150,26 @@ values: (V,) per welded vertex (per="vertex") or (F,) per face (per="face"), mod
 
   m.def(
       "load",
-      [](const std::string& path, float weld_tolerance) {
+      [](const std::string& path, float weld_tolerance, bool allow_external_paths,
+         std::uint64_t max_triangles, std::uint64_t max_file_size) {
         if (!(weld_tolerance >= 0.0f))
           throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
+        const io::LoadOptions options{weld_tolerance, allow_external_paths, max_triangles, max_file_size};
         py::gil_scoped_release unlocked;
-        return std::make_shared<io::Asset>(load_input(path, io::LoadOptions{weld_tolerance}));
+        return std::make_shared<io::Asset>(load_input(path, options));
       },
-      "path"_a, "weld_tolerance"_a = 0.0f,
+      "path"_a, "weld_tolerance"_a = 0.0f, py::kw_only(), "allow_external_paths"_a = false,
+      "max_triangles"_a = io::kDefaultMaxTriangles, "max_file_size"_a = io::kDefaultMaxFileSize,
       R"doc(Loads a mesh file (.gltf .glb .obj .off .ply) or a built-in shape ("builtin:sphere",
 "builtin:torus", "builtin:capsule", "builtin:slab", "builtin:tube") and returns an sdfkit.Asset.
 
 Positions closer than weld_tolerance (model units; 0 = bitwise-equal only) are welded into one
-vertex. Raises sdfkit.InputError "<path>: <problem>" for a missing or malformed file.)doc");
+vertex. Raises sdfkit.InputError "<path>: <problem>" for a missing or malformed file.
+
+Assets are untrusted (SECURITY.md): a glTF's external buffers and images are read only from
+inside its own directory unless allow_external_paths=True; an asset with more than
+max_triangles triangles, or a file larger than max_file_size bytes, is refused before it is
+read (0 = no limit).)doc");
 }
 
 void bind_session(py::module_& m) {
@@ -260,7 +268,8 @@ void bind_functions(py::module_& m) {
       [](const std::string& input, const std::optional<std::string>& output, Session* session,
          const std::string& backend, const std::string& device, int views, int resolution, std::size_t memory_cap,
          const std::string& per, int rays, float cone, const std::string& false_hits, int smooth, bool normalize,
-         bool color, float weld_tolerance) {
+         bool color, float weld_tolerance, bool allow_external_paths, std::uint64_t max_triangles,
+         std::uint64_t max_file_size) {
         ComputeRequest request;
         request.input = input;
         request.output = output.value_or("");
@@ -272,6 +281,9 @@ void bind_functions(py::module_& m) {
         if (!(weld_tolerance >= 0.0f))
           throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
         request.load.weld_tolerance = weld_tolerance;
+        request.load.allow_external_paths = allow_external_paths;
+        request.load.max_triangles = max_triangles;
+        request.load.max_file_size = max_file_size;
         request.backend = make_config(backend, device, views, resolution, memory_cap);
         if (session && (request.backend.kind != BackendKind::Auto || !device.empty() || views || resolution || memory_cap))
           throw InputError("compute_file: pass either session or backend options (backend, device, views, "
@@ -291,6 +303,8 @@ void bind_functions(py::module_& m) {
       "device"_a = "", "views"_a = 0, "resolution"_a = 0, "memory_cap"_a = 0, "per"_a = "vertex",
       "rays"_a = kDefaultRays, "cone"_a = kDefaultConeDegrees, "false_hits"_a = "paper", "smooth"_a = 0,
       "normalize"_a = false, "color"_a = true, "weld_tolerance"_a = 0.0f,
+      "allow_external_paths"_a = false, "max_triangles"_a = io::kDefaultMaxTriangles,
+      "max_file_size"_a = io::kDefaultMaxFileSize,
       R"doc(What `sdfkit compute INPUT -o OUTPUT` does: load, compute, optionally smooth, write
 atomically. Returns the JSON report (`sdfkit compute --json`) as a dict: input, output, ok,
 counts {input_vertices, input_faces, welded_vertices, points, filled_points}, backend, device,
@@ -302,7 +316,8 @@ session an sdfkit.Session to reuse (its mesh is replaced), else a backend is ope
         backend/device/views/resolution/memory_cap (only after the input loaded)
 per, rays, cone, false_hits  as in Session.compute
 smooth  k-ring Gaussian smoothing (rings, 0 = off); normalize: write [0, 1] values to .txt/.ply
-color   write colours (glTF COLOR_0, PLY rgb); weld_tolerance: as in sdfkit.load)doc");
+color   write colours (glTF COLOR_0, PLY rgb); weld_tolerance, allow_external_paths,
+        max_triangles, max_file_size: as in sdfkit.load)doc");
 
   m.def(
       "smooth",

@@ -448,6 +448,37 @@ class ErrorTest(unittest.TestCase):
             with self.assertRaisesRegex(sdfkit.InputError, "unknown extension"):
                 sdfkit.load(os.path.join(tmp, "mesh.xyz"))
 
+    def test_untrusted_assets(self):
+        """A glTF's buffer outside its directory is refused unless allow_external_paths; the
+        limits refuse big assets (SECURITY.md)."""
+        with tempfile.TemporaryDirectory() as tmp:
+            xyz = struct.pack("<12f", 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1)
+            idx = struct.pack("<12H", 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3)
+            with open(os.path.join(tmp, "secret.bin"), "wb") as out:
+                out.write(xyz + idx)
+            os.mkdir(os.path.join(tmp, "assets"))
+            path = os.path.join(tmp, "assets", "evil.gltf")
+            with open(path, "w") as out:
+                out.write('{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],'
+                          '"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":'
+                          '{"POSITION":0},"indices":1}]}],"accessors":[{"bufferView":0,'
+                          '"componentType":5126,"count":4,"type":"VEC3"},{"bufferView":1,'
+                          '"componentType":5123,"count":12,"type":"SCALAR"}],"bufferViews":'
+                          '[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,'
+                          '"byteLength":24}],"buffers":[{"byteLength":72,"uri":"../secret.bin"}]}')
+            with self.assertRaisesRegex(sdfkit.InputError, re.escape("external reference '../secret.bin'")):
+                sdfkit.load(path)
+            asset = sdfkit.load(path, allow_external_paths=True)
+            self.assertEqual(len(asset.faces), 4)
+            self.assertEqual(len(sdfkit.load(path, allow_external_paths=True, max_triangles=4).faces), 4)
+            with self.assertRaisesRegex(sdfkit.InputError, "more than the limit of 3 triangles"):
+                sdfkit.load(path, allow_external_paths=True, max_triangles=3)
+            with self.assertRaisesRegex(sdfkit.InputError, "more than the limit of 100"):
+                sdfkit.load(path, allow_external_paths=True, max_file_size=100)
+            with self.assertRaisesRegex(sdfkit.InputError, re.escape("'../secret.bin'")):
+                sdfkit.compute_file(path, os.path.join(tmp, "out.ply"))
+            self.assertFalse(os.path.exists(os.path.join(tmp, "out.ply")))
+
     def test_device_errors(self):
         with self.assertRaises(sdfkit.DeviceError) as caught:
             sdfkit.Session("opencl", device="no-such-device-anywhere")

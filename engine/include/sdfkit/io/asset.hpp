@@ -31,11 +31,30 @@ Format format_from_path(const std::string& path);
 // Lower-case name of a format ("gltf", "off", ...).
 const char* format_name(Format format);
 
+// Defaults of the resource limits below (see SECURITY.md for the memory they bound).
+inline constexpr std::uint64_t kDefaultMaxTriangles = 50'000'000;
+inline constexpr std::uint64_t kDefaultMaxFileSize = std::uint64_t{2} << 30;  // 2 GiB
+
 struct LoadOptions {
   // Positions closer than this (model units, after glTF node transforms) become one welded
   // vertex; 0 welds bitwise-equal positions only. See sdfkit::weld.
   float weld_tolerance = 0.0f;
+  // Asset contents are untrusted (SECURITY.md). By default a glTF's external buffers and images
+  // are read only from inside the asset's own directory (after resolving `..` and symbolic
+  // links); absolute paths, parent escapes, URI schemes other than data: and links leading
+  // outside are refused without being opened. true lifts this for trusted trees (relative URIs
+  // still resolve against the asset's directory, absolute ones as they are).
+  bool allow_external_paths = false;
+  // An asset with more triangles than this is refused (InputError) as soon as a count is known,
+  // before the engine allocates for it; vertices are limited to 3 x max_triangles. 0 = no limit.
+  std::uint64_t max_triangles = kDefaultMaxTriangles;
+  // A file larger than this (bytes: the asset, and each file a glTF references) is refused
+  // before it is read. 0 = no limit.
+  std::uint64_t max_file_size = kDefaultMaxFileSize;
 };
+
+// Throws InputError unless the options are usable (weld tolerance finite and >= 0).
+void validate_load_options(const LoadOptions& options);
 
 struct Asset {
   std::string path;
@@ -60,7 +79,8 @@ struct Asset {
 
 // Loads a mesh file (format by extension). Throws InputError with one line "<path>: <problem>"
 // for a missing or unreadable file, a malformed or truncated file, indices out of range,
-// non-finite coordinates or a file without any triangle.
+// non-finite coordinates, a file without any triangle, a glTF reference refused by the
+// confinement above or an asset past options' limits.
 Asset load_asset(const std::string& path, const LoadOptions& options = {});
 
 // Extra geometry written into glTF outputs as a node of its own at the scene root (a
