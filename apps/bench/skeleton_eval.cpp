@@ -39,6 +39,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <fstream>
@@ -250,7 +251,9 @@ Eval run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend, bool sdf_
   co.sdf_term = sdf_terms;
   try {
     const auto t0 = std::chrono::steady_clock::now();
-    const sk::Skeleton s = sk::extract(mesh, &backend, co, {});
+    sk::SkeletonOptions so;  // library defaults; SDFKIT_EVAL_EXTEND_LEAVES=0 for the comparison
+    if (const char* v = std::getenv("SDFKIT_EVAL_EXTEND_LEAVES")) so.extend_leaves = std::atoi(v) != 0;
+    const sk::Skeleton s = sk::extract(mesh, &backend, co, so);
     const double seconds = seconds_since(t0);
     Eval e = measure(s, bvh);
     e.seconds = seconds;

@@ -816,6 +816,45 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
       for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
     }
   }
+  // Leaves reach the end of their limb: a curve leaf's node sits at the centre of its vertices'
+  // region, short of the limb's tip. Its vertex farthest along the direction from its neighbour
+  // gives the tip (that vertex's centre point); when the tip lies over a node radius beyond the
+  // leaf and the segment to it is inside, a tip node takes the leaf's vertices that lie beyond
+  // the midpoint and see it (the leaf keeps at least one).
+  if (options.extend_leaves) {
+    std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+    for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+    const std::size_t count = sk.nodes.size();
+    for (std::uint32_t leaf = 0; leaf < count; ++leaf) {
+      if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) continue;
+      const glm::vec3 p = sk.nodes[leaf].position, q = sk.nodes[adjacency[leaf].front()].position;
+      const float len = glm::length(p - q);
+      if (!(len > 0.0f)) continue;
+      const glm::vec3 dir = (p - q) / len;
+      std::uint32_t far_vertex = sk.nodes[leaf].vertices.front();
+      for (std::uint32_t k : sk.nodes[leaf].vertices)
+        if (glm::dot(original.positions[k] - p, dir) > glm::dot(original.positions[far_vertex] - p, dir)) far_vertex = k;
+      const glm::vec3 tip = surface.centre[far_vertex];
+      if (glm::dot(tip - p, dir) <= sk.nodes[leaf].radius || !surface.bvh.inside(tip) ||
+          surface.bvh.segment_blocked(p, tip))
+        continue;
+      const glm::vec3 mid = 0.5f * (p + tip);
+      std::vector<std::uint32_t> moved, kept;
+      for (std::uint32_t k : sk.nodes[leaf].vertices)
+        (glm::dot(original.positions[k] - mid, dir) > 0.0f && surface.sees(k, tip) ? moved : kept).push_back(k);
+      if (moved.empty() || kept.empty()) continue;
+      sk.nodes[leaf].vertices = std::move(kept);
+      sk.nodes[leaf].radius = surface.radius(p, sk.nodes[leaf].vertices);
+      Node node;
+      node.position = tip;
+      node.vertices = std::move(moved);
+      node.radius = surface.radius(tip, node.vertices);
+      const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+      for (std::uint32_t k : node.vertices) node_of_vertex[k] = id;
+      sk.nodes.push_back(std::move(node));
+      add_edge(leaf, id);
+    }
+  }
   // Sheet-triangle edges are part of the sheet, not curve edges.
   std::set<std::array<std::uint32_t, 2>> sheet_edges;
   for (const Triangle& t : sk.sheet_triangles)
