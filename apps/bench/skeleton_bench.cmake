@@ -27,7 +27,19 @@ if(NOT _skeleton_bench_tar EQUAL 0)
   return()
 endif()
 
-add_executable(sdfkit_skeleton_bench ${CMAKE_CURRENT_LIST_DIR}/skeleton_bench.cpp)
+# The evaluation's data set: all of CGAL's data/ (sdfkit_skeleton_bench --eval DIR).
+set(SDFKIT_SKELETON_EVAL_DATA "${CMAKE_CURRENT_BINARY_DIR}/skeleton_eval_data")
+if(NOT EXISTS "${SDFKIT_SKELETON_EVAL_DATA}/meshes")
+  file(MAKE_DIRECTORY "${SDFKIT_SKELETON_EVAL_DATA}")
+  execute_process(
+    COMMAND tar -xzf "/usr/share/doc/libcgal-dev/data.tar.gz" -C "${SDFKIT_SKELETON_EVAL_DATA}" --strip-components=1
+    RESULT_VARIABLE _skeleton_eval_tar)
+endif()
+
+add_executable(sdfkit_skeleton_bench ${CMAKE_CURRENT_LIST_DIR}/skeleton_bench.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/skeleton_eval.cpp)
+# The evaluation's containment checks use the library's CPU BVH (a private header).
+target_include_directories(sdfkit_skeleton_bench PRIVATE ${PROJECT_SOURCE_DIR}/engine/skeleton)
 target_link_libraries(sdfkit_skeleton_bench PRIVATE
   sdfkit::skeleton sdfkit::reference sdfkit::io CGAL::CGAL Eigen3::Eigen)
 target_compile_definitions(sdfkit_skeleton_bench PRIVATE

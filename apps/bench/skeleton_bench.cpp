@@ -3,6 +3,11 @@
 // same meshes, in the same run. Prints a Markdown table.
 //
 // usage: sdfkit_skeleton_bench [--backend opencl|embree] [--runs N] [MESH.off ...]
+//        sdfkit_skeleton_bench [--backend ...] --eval DIR [--filter TEXT] [--dump DIR]
+//                              [--max-vertices N] [--no-sdf-off] [--no-models]
+//   --eval     the evaluation (skeleton_eval.cpp): every closed mesh under DIR (CGAL's data set:
+//              the build tree's skeleton_eval_data) up to --max-vertices (100000) vertices plus
+//              the procedural models, with the SDF terms on and off, beside CGAL's MCF
 //   --backend  the SDF backend: the engine's OpenCL ray caster (the default when built and a
 //              device works; PoCL on a CPU) or the Embree CPU reference
 //   --runs     run each side N times and report the fastest (default 1)
@@ -12,6 +17,7 @@
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/reference/embree_backend.hpp"
 #include "sdfkit/skeleton/skeleton.hpp"
+#include "skeleton_eval.hpp"
 #ifdef SDFKIT_SKELETON_BENCH_OPENCL
 #include "sdfkit/opencl/opencl_backend.hpp"
 #endif
@@ -135,14 +141,31 @@ int main(int argc, char** argv) {
   std::vector<std::string> paths;
   std::string backend_name;
   int runs = 1;
+  SkeletonEvalArgs eval;
+  bool eval_mode = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--backend" && i + 1 < argc) {
+    if (arg == "--eval" && i + 1 < argc) {
+      eval_mode = true;
+      eval.dir = argv[++i];
+    } else if (arg == "--filter" && i + 1 < argc) {
+      eval.filter = argv[++i];
+    } else if (arg == "--dump" && i + 1 < argc) {
+      eval.dump = argv[++i];
+    } else if (arg == "--max-vertices" && i + 1 < argc) {
+      eval.max_vertices = std::strtoul(argv[++i], nullptr, 10);
+    } else if (arg == "--no-sdf-off") {
+      eval.no_sdf_run = false;
+    } else if (arg == "--no-models") {
+      eval.procedural = false;
+    } else if (arg == "--backend" && i + 1 < argc) {
       backend_name = argv[++i];
     } else if (arg == "--runs" && i + 1 < argc) {
       runs = std::max(1, std::atoi(argv[++i]));
     } else if (arg.rfind("--", 0) == 0) {
-      std::fprintf(stderr, "usage: sdfkit_skeleton_bench [--backend opencl|embree] [--runs N] [MESH.off ...]\n");
+      std::fprintf(stderr, "usage: sdfkit_skeleton_bench [--backend opencl|embree] [--runs N] [MESH.off ...]\n"
+                           "       sdfkit_skeleton_bench [--backend opencl|embree] --eval DIR [--filter TEXT] "
+                           "[--dump DIR] [--max-vertices N] [--no-sdf-off] [--no-models]\n");
       return 2;
     } else {
       paths.push_back(arg);
@@ -166,6 +189,7 @@ int main(int argc, char** argv) {
     } else {
       backend = make_backend(backend_name);
     }
+    if (eval_mode) return run_skeleton_eval(eval, *backend);
     const auto co = contraction_options();
     std::printf("SDF backend: %s (%s); %d rays for the input's SDF, %d per later contraction "
                 "iteration; proxy above %zu vertices; best of %d run(s)\n\n",

@@ -13,8 +13,11 @@
 #include "sdfkit/core/log.hpp"
 #include "sdfkit/core/parallel.hpp"
 #include "sdfkit/core/topology.hpp"
+#include "sdfkit/core/union_find.hpp"
 
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -181,6 +184,9 @@ void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in
     for (std::uint32_t k : node.vertices) node_of_vertex[k] = static_cast<std::uint32_t>(nodes.size());
     nodes.push_back(std::move(node));
   };
+  // One point per cell: the mean of its sheet points (or the member's point closest to it).
+  std::vector<glm::vec3> cell_point;
+  std::vector<const std::vector<std::uint32_t>*> cell_members;
   for (const auto& [key, members] : cells) {
     glm::dvec3 mean(0.0);
     for (std::uint32_t k : members) mean += glm::dvec3(point[k]);
@@ -191,15 +197,35 @@ void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in
         if (glm::length(point[k] - p) < glm::length(point[best] - p)) best = k;
       p = point[best];
     }
-    std::vector<std::uint32_t> seeing;
-    for (std::uint32_t k : members) {
-      if (surface.sees(k, p))
-        seeing.push_back(k);
-      else
-        add(point[k], {k});
-    }
-    if (!seeing.empty()) add(p, std::move(seeing));
+    cell_point.push_back(p);
+    cell_members.push_back(&members);
   }
+  // A member that cannot see its cell's point joins the nearest of the 8 nearest other cells'
+  // points that it sees (a fold of the sheet), and only then gets a node of its own.
+  std::vector<std::vector<std::uint32_t>> seeing(cell_point.size());
+  std::vector<std::uint32_t> alone;
+  for (std::size_t c = 0; c < cell_point.size(); ++c)
+    for (std::uint32_t k : *cell_members[c]) {
+      if (surface.sees(k, cell_point[c])) {
+        seeing[c].push_back(k);
+        continue;
+      }
+      std::vector<std::pair<float, std::size_t>> near;
+      for (std::size_t d = 0; d < cell_point.size(); ++d)
+        if (d != c) near.push_back({glm::length(cell_point[d] - point[k]), d});
+      const std::size_t tried = std::min<std::size_t>(near.size(), 8);
+      std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(tried), near.end());
+      bool placed = false;
+      for (std::size_t i = 0; i < tried && !placed; ++i)
+        if (surface.sees(k, cell_point[near[i].second])) seeing[near[i].second].push_back(k), placed = true;
+      if (!placed) alone.push_back(k);
+    }
+  for (std::size_t c = 0; c < cell_point.size(); ++c)
+    if (!seeing[c].empty()) {
+      std::sort(seeing[c].begin(), seeing[c].end());
+      add(cell_point[c], std::move(seeing[c]));
+    }
+  for (std::uint32_t k : alone) add(point[k], {k});
 }
 
 // Wall-clock time of the stages of build_skeleton, logged at debug level.
@@ -218,6 +244,32 @@ private:
 
 // Nodes nearest to a vertex that are tried when it cannot see its own node.
 constexpr std::size_t kNearestNodes = 8;
+// Regions of vertices that see no curve node are split into pieces on a grid of this cell
+// (fraction of the bbox diagonal) ...
+constexpr double kRegionCell = 0.05;
+// ... and a piece is flat (part of a sheet) when the second principal spread of its centre
+// points exceeds this fraction of the first.
+constexpr double kFlatRatio = 0.25;
+// A flat region becomes a sheet only when it holds at least this share of the surface's
+// vertices; a smaller one (a palm, a fist, a flat ear's tip) gets curve nodes.
+constexpr double kSheetRegionShare = 0.05;
+
+// lambda_2 / lambda_1 of a symmetric positive semi-definite 3x3 matrix (0 when it is zero).
+double second_eigenvalue_ratio(const glm::dmat3& a) {
+  const double p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+  const double q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
+  const double p2 = (a[0][0] - q) * (a[0][0] - q) + (a[1][1] - q) * (a[1][1] - q) +
+                    (a[2][2] - q) * (a[2][2] - q) + 2.0 * p1;
+  const double p = std::sqrt(p2 / 6.0);
+  if (!(p > 0.0)) return q > 0.0 ? 1.0 : 0.0;
+  const glm::dmat3 b = (1.0 / p) * (a - q * glm::dmat3(1.0));
+  const double r = std::clamp(glm::determinant(b) / 2.0, -1.0, 1.0);
+  const double phi = std::acos(r) / 3.0;
+  const double e1 = q + 2.0 * p * std::cos(phi);
+  const double e3 = q + 2.0 * p * std::cos(phi + 2.0943951023931953);
+  const double e2 = 3.0 * q - e1 - e3;
+  return e1 > 0.0 ? std::max(0.0, e2) / e1 : 0.0;
+}
 
 void validate(const SkeletonOptions& o) {
   if (!(o.ggt >= 0.0 && o.ggt < 1.0)) throw InputError("skeleton option ggt must be in [0, 1)");
@@ -294,11 +346,15 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   so.grouping_local = options.gmt;
   Stopwatch watch;
   const Surface surface(original, contracted, sdf);
+  // Grouping never joins nodes whose segment leaves the solid (a head grouped with the feet).
+  so.segment_inside = [&surface](const glm::vec3& a, const glm::vec3& b) {
+    return !surface.bvh.segment_blocked(a, b) && surface.bvh.inside(a);
+  };
   watch.lap("BVH and centre points");
-  const detail::CurveGraph graph = surgery(surface, local_radius, proxy, so);
+  detail::CurveGraph graph = surgery(surface, local_radius, proxy, so);
   watch.lap("connectivity surgery");
 
-  const std::size_t curve_nodes = graph.positions.size();
+  std::size_t curve_nodes = graph.positions.size();
   std::vector<std::uint32_t> owner(n);
   for (std::uint32_t c = 0; c < curve_nodes; ++c)
     for (std::uint32_t k : graph.members[c]) owner[k] = c;
@@ -319,6 +375,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   // Per vertex, independently (node positions are fixed here): the node it ends with, or
   // UINT32_MAX when it sees none (then, with sheets on, its sheet point if it has one).
   std::vector<std::uint32_t> choice(n);
+  std::vector<std::uint32_t> leftover_unseen;
   std::vector<std::uint8_t> has_sheet_point(n, 0);
   std::vector<glm::vec3> sheet_point(n);
   parallel_for(n, [&](std::size_t begin, std::size_t end) {
@@ -342,14 +399,162 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
           choice[k] = c;
           break;
         }
-      if (choice[k] == UINT32_MAX && options.sheets)
-        if (const auto p = surface.sheet_point(k)) has_sheet_point[k] = 1, sheet_point[k] = *p;
     }
   });
+  // Regions of vertices that see no curve node (connected over mesh edges) get a curve node of
+  // their own where one stands for them: a part the contraction merged into its neighbour (a
+  // finger, an ear, a limb's end) whose vertices see the centre of their region. The node sits
+  // at the mean of the region's centre points and is joined to the nearest curve node it sees
+  // through the solid. A region is left to the sheets when fewer than half its vertices see
+  // that point (a non-convex cross-section: the C and S plates) or no node is seen from it.
+  // Up to three rounds: what the first node leaves unseen (a long limb's tip) may get the next.
+  std::vector<std::uint8_t> region_is_sheet(n, 0);
+  for (int round = 0; round < 3; ++round) {
+    UnionFind regions(n);
+    bool any = false;
+    for (const Triangle& t : original.triangles)
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+        if (choice[a] == UINT32_MAX && choice[b] == UINT32_MAX && !region_is_sheet[a]) regions.unite(a, b);
+      }
+    std::map<std::uint32_t, std::vector<std::uint32_t>> region_members;  // root -> vertices (ascending)
+    std::vector<std::uint32_t> region_order;
+    for (std::uint32_t k = 0; k < n; ++k)
+      if (choice[k] == UINT32_MAX && !region_is_sheet[k]) {
+        auto [it, inserted] = region_members.try_emplace(regions.find(k));
+        if (inserted) region_order.push_back(regions.find(k));
+        it->second.push_back(k);
+      }
+    // A new curve node at the mean of `part`'s centre points for the vertices of `part` that
+    // see it, joined to the nearest curve node it sees; false when under half of them see it or
+    // no node is seen from it.
+    auto add_node = [&](const std::vector<std::uint32_t>& part) {
+      glm::dvec3 mean(0.0);
+      for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
+      glm::vec3 p(mean / static_cast<double>(part.size()));
+      if (!surface.bvh.inside(p)) {
+        std::uint32_t best = part.front();
+        for (std::uint32_t k : part)
+          if (glm::length(surface.centre[k] - p) < glm::length(surface.centre[best] - p)) best = k;
+        p = surface.centre[best];
+      }
+      std::vector<std::uint32_t> seeing;
+      for (std::uint32_t k : part)
+        if (surface.sees(k, p)) seeing.push_back(k);
+      if (2 * seeing.size() < part.size()) return false;
+      std::vector<std::pair<float, std::uint32_t>> by_distance;
+      for (std::uint32_t c = 0; c < curve_nodes; ++c) by_distance.push_back({glm::length(position[c] - p), c});
+      const std::size_t tried = std::min<std::size_t>(by_distance.size(), 64);
+      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
+                        by_distance.end());
+      std::uint32_t attach = UINT32_MAX;
+      for (std::size_t i = 0; i < tried; ++i)
+        if (!surface.bvh.segment_blocked(p, position[by_distance[i].second])) {
+          attach = by_distance[i].second;
+          break;
+        }
+      if (attach == UINT32_MAX) return false;
+      const auto c = static_cast<std::uint32_t>(curve_nodes++);
+      position.push_back(p);
+      members.emplace_back();
+      graph.members.emplace_back();
+      graph.positions.push_back(p);
+      graph_adjacency.emplace_back();
+      graph.edges.push_back({std::min(attach, c), std::max(attach, c)});
+      graph_adjacency[attach].push_back(c);
+      graph_adjacency[c].push_back(attach);
+      for (std::uint32_t k : seeing) choice[k] = c;
+      return true;
+    };
+    for (std::uint32_t root : region_order) {
+      const std::vector<std::uint32_t>& region = region_members[root];
+      if (add_node(region)) {
+        any = true;
+        continue;
+      }
+      // The region is too large or bent for one node. Split it into pieces of connected
+      // vertices whose centre points share a cell of kRegionCell * diag, and look at the shape
+      // of each piece's centre points: along a tube they lie on a line (the second principal
+      // spread is small), across a plate with a non-convex cross-section they fill the cell.
+      // A region whose pieces are mostly flat is a sheet; otherwise each piece gets a node,
+      // nearest to the existing skeleton first, so a missed limb becomes a chain of nodes.
+      const double cell = kRegionCell * diag;
+      std::map<std::array<std::int64_t, 3>, std::uint32_t> cell_index;
+      std::vector<std::uint32_t> cell_of(region.size());
+      std::map<std::uint32_t, std::uint32_t> slot;  // vertex -> index in region
+      for (std::uint32_t i = 0; i < region.size(); ++i) {
+        const glm::vec3 q = surface.centre[region[i]];
+        const std::array<std::int64_t, 3> key{static_cast<std::int64_t>(std::floor(q.x / cell)),
+                                              static_cast<std::int64_t>(std::floor(q.y / cell)),
+                                              static_cast<std::int64_t>(std::floor(q.z / cell))};
+        cell_of[i] = cell_index.try_emplace(key, static_cast<std::uint32_t>(cell_index.size())).first->second;
+        slot[region[i]] = i;
+      }
+      UnionFind pieces(region.size());
+      for (const Triangle& t : original.triangles)
+        for (int e = 0; e < 3; ++e) {
+          const auto a = slot.find(t[e]), b = slot.find(t[(e + 1) % 3]);
+          if (a != slot.end() && b != slot.end() && cell_of[a->second] == cell_of[b->second])
+            pieces.unite(a->second, b->second);
+        }
+      std::map<std::uint32_t, std::vector<std::uint32_t>> piece_members;
+      std::vector<std::uint32_t> piece_order;
+      for (std::uint32_t i = 0; i < region.size(); ++i) {
+        auto [it, inserted] = piece_members.try_emplace(pieces.find(i));
+        if (inserted) piece_order.push_back(pieces.find(i));
+        it->second.push_back(region[i]);
+      }
+      double flat = 0.0, total = 0.0;
+      for (std::uint32_t r : piece_order) {
+        const std::vector<std::uint32_t>& piece = piece_members[r];
+        if (piece.size() < 4) continue;
+        glm::dvec3 m(0.0);
+        for (std::uint32_t k : piece) m += glm::dvec3(surface.centre[k]);
+        m /= static_cast<double>(piece.size());
+        glm::dmat3 cov(0.0);
+        for (std::uint32_t k : piece) {
+          const glm::dvec3 d = glm::dvec3(surface.centre[k]) - m;
+          cov += glm::outerProduct(d, d);
+        }
+        // Eigenvalues of the symmetric 3x3 covariance (trigonometric solution).
+        const double l2 = second_eigenvalue_ratio(cov);
+        total += static_cast<double>(piece.size());
+        if (l2 > kFlatRatio) flat += static_cast<double>(piece.size());
+      }
+      if (total > 0.0 && flat > 0.5 * total &&
+          static_cast<double>(region.size()) >= kSheetRegionShare * static_cast<double>(n)) {
+        for (std::uint32_t k : region) region_is_sheet[k] = 1;
+        continue;
+      }
+      std::vector<std::pair<float, std::uint32_t>> order;
+      for (std::uint32_t r : piece_order) {
+        float best = std::numeric_limits<float>::max();
+        for (std::uint32_t c = 0; c < curve_nodes; ++c)
+          best = std::min(best, glm::length(position[c] - surface.centre[piece_members[r].front()]));
+        order.push_back({best, r});
+      }
+      std::sort(order.begin(), order.end());
+      for (const auto& [d, r] : order) any |= add_node(piece_members[r]);
+    }
+    if (!any) break;
+  }
+  // Vertices still without a node outside sheet regions (a few around a new node) stay with
+  // the node the surgery gave them: unreliable, but no sheet blob at a limb's end.
+  for (std::uint32_t k = 0; k < n; ++k)
+    if (choice[k] == UINT32_MAX && !region_is_sheet[k]) {
+      choice[k] = owner[k];
+      leftover_unseen.push_back(k);
+    }
   // Apply in vertex order: a vertex moves to its chosen node; one that sees none stays
   // (failing) or, with sheets, leaves its curve node and becomes a sheet vertex (below).
+  if (options.sheets)
+    parallel_for(n, [&](std::size_t begin, std::size_t end) {
+      for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k)
+        if (choice[k] == UINT32_MAX)
+          if (const auto p = surface.sheet_point(k)) has_sheet_point[k] = 1, sheet_point[k] = *p;
+    });
   std::vector<std::uint8_t> in_sheet(n, 0);
-  std::size_t failing = 0;
+  std::size_t failing = leftover_unseen.size();
   std::vector<std::vector<std::uint32_t>> moved_in(curve_nodes);
   for (std::uint32_t k = 0; k < n; ++k) {
     if (choice[k] == owner[k]) continue;
@@ -460,6 +665,196 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
     }
     for (const auto& [key, value] : best) add_edge(key.first, value.second);
   }
+  // Edges whose segment leaves the solid (embedding refinement moved their ends apart around a
+  // concavity, or a sheet link crosses a fold) are replaced by a detour through the node c that
+  // minimizes |ac| + |cb| with both segments inside (of the 256 best); without one, where
+  // dropping the edge splits the skeleton, the two parts are joined again by the shortest
+  // segment between them that stays inside (of the 256 shortest pairs). An edge that neither
+  // finds is kept (a connected skeleton with its cycles comes first) and marked, so that the
+  // cycle pruning below drops it before any edge inside.
+  std::set<std::array<std::uint32_t, 2>> through_air;
+  {
+    std::vector<std::array<std::uint32_t, 2>> blocked;
+    for (const auto& e : edges)
+      if (surface.bvh.segment_blocked(sk.nodes[e[0]].position, sk.nodes[e[1]].position)) blocked.push_back(e);
+    auto inside_segment = [&](std::uint32_t a, std::uint32_t b) {
+      return !surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position);
+    };
+    if (!blocked.empty()) {
+      for (const auto& e : blocked) edges.erase(e);
+      std::vector<std::array<std::uint32_t, 2>> unresolved;
+      for (const auto& e : blocked) {
+        const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+        std::vector<std::pair<float, std::uint32_t>> via;
+        for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
+          if (c != e[0] && c != e[1])
+            via.push_back({glm::length(sk.nodes[c].position - pa) + glm::length(sk.nodes[c].position - pb), c});
+        const std::size_t tried = std::min<std::size_t>(via.size(), 256);
+        std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
+        bool detoured = false;
+        for (std::size_t i = 0; i < tried && !detoured; ++i)
+          if (inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
+            add_edge(e[0], via[i].second);
+            add_edge(via[i].second, e[1]);
+            detoured = true;
+          }
+        if (!detoured) unresolved.push_back(e);
+      }
+      log_debug("skeleton: " + std::to_string(blocked.size()) + " edges leave the solid, " +
+                std::to_string(blocked.size() - unresolved.size()) + " detoured");
+      // Then a detour through a new node at the centre point of one of the two nodes' vertices
+      // (the vertex moves to the new node; its old node keeps at least one vertex).
+      std::vector<std::array<std::uint32_t, 2>> still;
+      for (const auto& e : unresolved) {
+        const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+        std::vector<std::pair<float, std::pair<std::uint32_t, std::uint32_t>>> via;  // (vertex, node)
+        for (std::uint32_t end : e)
+          if (!sk.nodes[end].sheet && sk.nodes[end].vertices.size() > 1)
+            for (std::uint32_t k : sk.nodes[end].vertices)
+              via.push_back({glm::length(surface.centre[k] - pa) + glm::length(surface.centre[k] - pb), {k, end}});
+        const std::size_t tried = std::min<std::size_t>(via.size(), 256);
+        std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
+        bool detoured = false;
+        for (std::size_t i = 0; i < tried && !detoured; ++i) {
+          const auto [k, end] = via[i].second;
+          const glm::vec3 c = surface.centre[k];
+          if (sk.nodes[end].vertices.size() < 2 || !surface.bvh.inside(c) ||
+              surface.bvh.segment_blocked(pa, c) || surface.bvh.segment_blocked(c, pb))
+            continue;
+          std::erase(sk.nodes[end].vertices, k);
+          Node node;
+          node.position = c;
+          node.vertices = {k};
+          node.radius = surface.radius(c, node.vertices);
+          const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+          sk.nodes.push_back(std::move(node));
+          node_of_vertex[k] = id;
+          add_edge(e[0], id);
+          add_edge(id, e[1]);
+          detoured = true;
+        }
+        if (!detoured) still.push_back(e);
+      }
+      UnionFind parts(sk.nodes.size());
+      for (const auto& e : edges) parts.unite(e[0], e[1]);
+      for (const Triangle& t : sk.sheet_triangles) parts.unite(t[0], t[1]), parts.unite(t[1], t[2]);
+      for (const auto& e : still) {
+        const std::uint32_t ra = parts.find(e[0]), rb = parts.find(e[1]);
+        if (ra == rb) {
+          add_edge(e[0], e[1]);
+          through_air.insert(e);
+          continue;
+        }
+        std::vector<std::uint32_t> in_a, in_b;
+        for (std::uint32_t v = 0; v < sk.nodes.size(); ++v) {
+          const std::uint32_t r = parts.find(v);
+          if (r == ra) in_a.push_back(v);
+          else if (r == rb) in_b.push_back(v);
+        }
+        std::vector<std::pair<float, std::array<std::uint32_t, 2>>> pairs;
+        for (std::uint32_t a : in_a)
+          for (std::uint32_t b : in_b)
+            pairs.push_back({glm::length(sk.nodes[a].position - sk.nodes[b].position), {a, b}});
+        const std::size_t tried = std::min<std::size_t>(pairs.size(), 256);
+        std::partial_sort(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(tried), pairs.end());
+        std::array<std::uint32_t, 2> join = e;
+        through_air.insert(e);
+        for (std::size_t i = 0; i < tried; ++i) {
+          const auto [a, b] = pairs[i].second;
+          if (!surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position)) {
+            join = pairs[i].second;
+            through_air.erase(e);
+            break;
+          }
+        }
+        add_edge(join[0], join[1]);
+        parts.unite(join[0], join[1]);
+      }
+    }
+  }
+  // A solid of genus g has a skeleton with g independent cycles. Nodes added for unseen regions,
+  // re-routed edges and sheet links can close more: with each sheet piece taken as one unit,
+  // the curve edges that close a cycle (shortest edges first into a spanning forest) are
+  // collected per mesh component, and all but the g longest of them are dropped.
+  {
+    UnionFind mesh_parts(n);
+    for (const Triangle& t : original.triangles) mesh_parts.unite(t[0], t[1]), mesh_parts.unite(t[1], t[2]);
+    std::map<std::uint32_t, long long> chi;
+    std::vector<std::uint8_t> used(n, 0);
+    for (const Triangle& t : original.triangles) {
+      const std::uint32_t r = mesh_parts.find(t[0]);
+      chi[r] += 1;
+      for (std::uint32_t v : t)
+        if (!used[v]) used[v] = 1, chi[r] += 1;
+    }
+    std::set<std::array<std::uint32_t, 2>> mesh_edges;
+    for (const Triangle& t : original.triangles)
+      for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+    for (const auto& e : mesh_edges) chi[mesh_parts.find(e[0])] -= 1;
+    std::set<std::array<std::uint32_t, 2>> in_triangles;
+    UnionFind forest(sk.nodes.size());
+    for (const Triangle& t : sk.sheet_triangles) {
+      forest.unite(t[0], t[1]), forest.unite(t[1], t[2]);
+      for (int i = 0; i < 3; ++i) in_triangles.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+    }
+    std::vector<std::pair<float, std::array<std::uint32_t, 2>>> by_length;
+    for (const auto& e : edges)
+      if (!in_triangles.count(e))
+        by_length.push_back({glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position), e});
+    std::sort(by_length.begin(), by_length.end());
+    // Edges through the air go into the forest last (so they close the cycles) and rank last.
+    std::stable_partition(by_length.begin(), by_length.end(),
+                          [&](const auto& x) { return !through_air.count(x.second); });
+    std::map<std::uint32_t, std::vector<std::pair<float, std::array<std::uint32_t, 2>>>> closing;
+    for (const auto& [length, e] : by_length)
+      if (!forest.unite(e[0], e[1]) && !sk.nodes[e[0]].vertices.empty())
+        closing[mesh_parts.find(sk.nodes[e[0]].vertices.front())].push_back(
+            {through_air.count(e) ? -length : length, e});
+    for (auto& [root, list] : closing) {
+      const auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+      std::sort(list.rbegin(), list.rend());
+      for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
+    }
+  }
+  // Leaves reach the end of their limb: a curve leaf's node sits at the centre of its vertices'
+  // region, short of the limb's tip. Its vertex farthest along the direction from its neighbour
+  // gives the tip (that vertex's centre point); when the tip lies over a node radius beyond the
+  // leaf and the segment to it is inside, a tip node takes the leaf's vertices that lie beyond
+  // the midpoint and see it (the leaf keeps at least one).
+  if (options.extend_leaves) {
+    std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+    for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+    const std::size_t count = sk.nodes.size();
+    for (std::uint32_t leaf = 0; leaf < count; ++leaf) {
+      if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) continue;
+      const glm::vec3 p = sk.nodes[leaf].position, q = sk.nodes[adjacency[leaf].front()].position;
+      const float len = glm::length(p - q);
+      if (!(len > 0.0f)) continue;
+      const glm::vec3 dir = (p - q) / len;
+      std::uint32_t far_vertex = sk.nodes[leaf].vertices.front();
+      for (std::uint32_t k : sk.nodes[leaf].vertices)
+        if (glm::dot(original.positions[k] - p, dir) > glm::dot(original.positions[far_vertex] - p, dir)) far_vertex = k;
+      const glm::vec3 tip = surface.centre[far_vertex];
+      if (glm::dot(tip - p, dir) <= sk.nodes[leaf].radius || !surface.bvh.inside(tip) ||
+          surface.bvh.segment_blocked(p, tip))
+        continue;
+      const glm::vec3 mid = 0.5f * (p + tip);
+      std::vector<std::uint32_t> moved, kept;
+      for (std::uint32_t k : sk.nodes[leaf].vertices)
+        (glm::dot(original.positions[k] - mid, dir) > 0.0f && surface.sees(k, tip) ? moved : kept).push_back(k);
+      if (moved.empty() || kept.empty()) continue;
+      sk.nodes[leaf].vertices = std::move(kept);
+      sk.nodes[leaf].radius = surface.radius(p, sk.nodes[leaf].vertices);
+      Node node;
+      node.position = tip;
+      node.vertices = std::move(moved);
+      node.radius = surface.radius(tip, node.vertices);
+      const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+      for (std::uint32_t k : node.vertices) node_of_vertex[k] = id;
+      sk.nodes.push_back(std::move(node));
+      add_edge(leaf, id);
+    }
+  }
   // Sheet-triangle edges are part of the sheet, not curve edges.
   std::set<std::array<std::uint32_t, 2>> sheet_edges;
   for (const Triangle& t : sk.sheet_triangles)
@@ -504,10 +899,10 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 }
 }  // namespace
 
-Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
-                 const SkeletonOptions& options) {
-  validate(options);
-  detail::require_closed(mesh, "skeleton extraction");
+namespace {
+// extract() on a closed edge-manifold mesh.
+Skeleton extract_manifold(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
+                          const SkeletonOptions& options) {
   using Clock = std::chrono::steady_clock;
   Skeleton::Timings seconds;
   SdfOptions so = contraction.sdf;
@@ -568,6 +963,35 @@ Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions
   sk.sdf = std::move(sdf);
   sk.seconds = seconds;
   sk.warnings.insert(sk.warnings.begin(), c.warnings.begin(), c.warnings.end());
+  return sk;
+}
+
+}  // namespace
+
+Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
+                 const SkeletonOptions& options) {
+  validate(options);
+  // A closed mesh with non-manifold edges (parts touching along an edge) is split there into
+  // closed edge-manifold surfaces; the skeleton is built for that mesh and its vertex indices
+  // are mapped back to the input's (the copies come after the input's vertices).
+  const detail::ManifoldSplit split = detail::split_non_manifold(mesh, "skeleton extraction");
+  if (!split.applied) return extract_manifold(mesh, backend, contraction, options);
+  Skeleton sk = extract_manifold(split.mesh, backend, contraction, options);
+  const std::size_t n = mesh.positions.size();
+  std::vector<std::uint8_t> assigned(n, 0);
+  for (Node& node : sk.nodes) {
+    std::vector<std::uint32_t> kept;
+    for (std::uint32_t k : node.vertices) {
+      const std::uint32_t v = split.original[k];
+      if (!assigned[v]) assigned[v] = 1, kept.push_back(v);
+    }
+    node.vertices = std::move(kept);
+  }
+  if (sk.sdf.size() > n) sk.sdf.resize(n);  // a copy's SDF is its original's (same vertex)
+  sk.warnings.insert(sk.warnings.begin(),
+                     "split " + std::to_string(split.non_manifold_edges) +
+                         " non-manifold edges (triangles paired across the solid they bound): " +
+                         std::to_string(split.mesh.positions.size() - n) + " vertices duplicated");
   return sk;
 }
 

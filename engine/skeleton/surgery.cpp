@@ -260,6 +260,8 @@ void group_nodes(Complex& c, const SurgeryOptions& o, std::size_t& groupings) {
       const std::uint32_t from = a_goes ? a : b, to = a_goes ? b : a;
       const double dt = o.grouping_global + o.grouping_local * c.radius(from);
       if (!(length < dt) || c.share_neighbour(from, to)) continue;
+      if (o.segment_inside && !o.segment_inside(glm::vec3(c.embedded(from)), glm::vec3(c.embedded(to))))
+        continue;  // the merged node would stand for parts that only meet through the air
       c.collapse(from, to);
       ++groupings;
       changed = true;

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -16,6 +17,9 @@ struct SurgeryOptions {
   double sampling_weight = 0.1;  // w_b
   double grouping_global = 0.0;  // ggt * bbox diagonal, model units
   double grouping_local = 0.0;   // gmt
+  // When set, grouping never joins two nodes unless this holds for their embedded positions
+  // (the skeleton: the segment between them stays inside the solid).
+  std::function<bool(const glm::vec3&, const glm::vec3&)> segment_inside;
 };
 
 struct CurveGraph {

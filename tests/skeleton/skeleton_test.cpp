@@ -327,24 +327,7 @@ TEST(SkeletonContraction, RecomputesTheSdfOnTheContractingMeshInOneSession) {
   EXPECT_LT(last[last.size() / 2], 0.2f * first[first.size() / 2]);
 }
 
-TEST(Skeleton, RealMeshesGiveAValidSkeletonOrAClearError) {
-  // CGAL's data: a closed animal, a mesh of degenerate triangles, an open cube.
-  for (const char* name : {"cow.off", "degtri_sliding.off", "cube-ouvert.off"}) {
-    const Mesh mesh = io::load_asset(test::data_mesh(name)).mesh;
-    try {
-      const sk::Skeleton s = run(mesh, true, true);
-      expect_partition_and_inside(mesh, s);
-      // A vertex on a zero-thickness fin sees no interior point at all: not all of them are 1.
-      EXPECT_GT(s.reliability, 0.99) << name;
-      std::printf("%s: %zu nodes, %zu edges, %zu sheet triangles, curve reliability %.4f, "
-                  "reliability %.4f, %d iterations\n", name, s.nodes.size(), s.edges.size(),
-                  s.sheet_triangles.size(), s.curve_reliability, s.reliability, s.iterations);
-    } catch (const InputError& e) {
-      std::printf("%s: %s\n", name, e.what());
-      EXPECT_GT(std::string(e.what()).size(), 20u);
-    }
-  }
-}
+// Real meshes: real_mesh_test.cpp.
 
 namespace {
 // Records the ray count of every SDF the contraction asks for.

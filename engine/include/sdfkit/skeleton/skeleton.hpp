@@ -13,8 +13,11 @@
 // ContractionOptions::proxy_vertices contracts a simplified proxy that way, then calls
 // set_mesh(input) once more for the input's own SDF.
 //
-// Input: a closed (watertight, edge-manifold) triangle mesh. A mesh with boundary edges or
-// non-manifold edges is refused with an InputError. A mesh of several components is contracted
+// Input: a closed (watertight) triangle mesh. A mesh with boundary edges is refused with an
+// InputError. extract() splits non-manifold edges (parts touching along an edge: the triangles
+// are paired across the solid they bound) and builds the skeleton of the split mesh, with node
+// vertices mapped back to the input's and a warning; contract() and build_skeleton() still
+// need an edge-manifold mesh. A mesh of several components is contracted
 // as one system (the Laplacian is block-diagonal, the SDF sees all components, as in the plain
 // SDF of that mesh); the skeleton then has one connected part per component.
 
@@ -138,6 +141,10 @@ struct SkeletonOptions {
   // Place each curve node at the centre of the part of the solid its vertices enclose (the mean
   // of their SDF centre points u - SDF/2 n); off = the contracted position (if inside).
   bool refine_embedding = true;
+  // Give each curve leaf a tip node at the centre point of its vertex farthest along the limb
+  // (when that lies over a node radius beyond the leaf, inside the solid): leaves reach the
+  // ends of limbs instead of stopping at the centre of the last node's region.
+  bool extend_leaves = true;
 };
 
 struct Node {
