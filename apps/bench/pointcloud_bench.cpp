@@ -1,0 +1,197 @@
+// Point-cloud skeleton benchmark (issue 14): the linear skeleton of every frame of the shared
+// Sibernetic worm (the outer-surface particles as an unoriented cloud) and of synthetic worms,
+// with each step's time, the polyline's mean distance to the true midline and head/tail swaps.
+//
+// usage: sdfkit_pointcloud_bench [--data DIR] [--segments N] [--backend opencl|embree]
+//                                [--synthetic N,N,...] [--runs R] [--linkage average|single]
+//                                [--neighbours K]
+//   --data       a Sibernetic frame set (default: ../shared/worm beside the source tree)
+//   --synthetic  point counts of synthetic worms to time (default 2000,30000)
+//   --runs       repetitions of the whole frame set; the per-step medians are over all runs
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/pointcloud/pointcloud.hpp"
+#include "sdfkit/reference/embree_backend.hpp"
+#ifdef SDFKIT_POINTCLOUD_BENCH_OPENCL
+#include "sdfkit/opencl/opencl_backend.hpp"
+#endif
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace pc = sdfkit::pointcloud;
+
+namespace {
+
+std::unique_ptr<sdfkit::SdfBackend> make(const std::string& name) {
+  if (name == "embree") return std::make_unique<sdfkit::reference::EmbreeBackend>();
+#ifdef SDFKIT_POINTCLOUD_BENCH_OPENCL
+  if (name == "opencl") return std::make_unique<sdfkit::cl::OpenClBackend>();
+#endif
+  throw sdfkit::InputError("unknown or unavailable backend " + name);
+}
+
+std::vector<pc::Polyline> read_midlines(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw sdfkit::InputError("cannot open " + path);
+  std::vector<pc::Polyline> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::size_t f;
+    int slice;
+    float x, y, z;
+    if (!(ls >> f >> slice >> x >> y >> z)) continue;
+    if (lines.size() <= f) lines.resize(f + 1);
+    lines[f].nodes.push_back({glm::vec3(x, y, z), 0.0f});  // slice 50 (tail) first
+  }
+  return lines;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+struct Summary {
+  std::map<std::string, std::vector<double>> steps;
+  std::vector<double> totals;
+  void add(const pc::SkeletonResult& r) {
+    double t = 0.0;
+    for (const auto& s : r.times) {
+      steps[s.step].push_back(s.milliseconds);
+      t += s.milliseconds;
+    }
+    totals.push_back(t);
+  }
+  void print(const char* label, std::size_t points) const {
+    std::printf("| %s | %zu |", label, points);
+    for (const char* s : {"neighbours", "normals", "orientation", "surface", "sdf", "shift", "clustering", "polyline"})
+      std::printf(" %.2f |", steps.count(s) ? median(steps.at(s)) : 0.0);
+    std::printf(" **%.1f** | %.1f |\n", median(totals), *std::max_element(totals.begin(), totals.end()));
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string data = std::string(SDFKIT_SOURCE_DIR) + "/../shared/worm";
+  std::string backend_name =
+#ifdef SDFKIT_POINTCLOUD_BENCH_OPENCL
+      "opencl";
+#else
+      "embree";
+#endif
+  int segments = 16, runs = 1;
+  std::vector<std::size_t> synthetic{2000, 30000};
+  pc::SkeletonOptions opt;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw sdfkit::InputError(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--data") data = next();
+    else if (a == "--segments") segments = std::stoi(next());
+    else if (a == "--backend") backend_name = next();
+    else if (a == "--runs") runs = std::stoi(next());
+    else if (a == "--neighbours") opt.neighbours = std::stoi(next());
+    else if (a == "--rays") opt.sdf.rays = std::stoi(next());
+    else if (a == "--linkage") opt.linkage = next() == "single" ? pc::Linkage::Single : pc::Linkage::Average;
+    else if (a == "--synthetic") {
+      synthetic.clear();
+      std::stringstream ss(next());
+      std::string tok;
+      while (std::getline(ss, tok, ','))
+        if (!tok.empty()) synthetic.push_back(std::stoul(tok));
+    } else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  opt.segments = segments;
+  try {
+    auto backend = make(backend_name);
+    std::printf("backend: %s (%s), k = %d, rays = %d, segments = %d, linkage = %s\n\n", backend->name().c_str(),
+                backend->device_name().c_str(), opt.neighbours, opt.sdf.rays, segments,
+                opt.linkage == pc::Linkage::Single ? "single" : "average");
+    const pc::FrameSet set = pc::read_frames(data, true);
+    const auto mid = read_midlines(data + "/midline.txt");
+    Summary worm;
+    std::vector<pc::Polyline> lines;
+    std::vector<double> err, err_sym;
+    std::size_t inexact = 0, ambiguous = 0;
+    for (int run = 0; run < runs; ++run) {
+      lines.clear();
+      for (std::size_t f = 0; f < set.frames.size(); ++f) {
+        pc::SkeletonResult r = pc::point_cloud_skeleton(set.frames[f], *backend, opt);
+        if (run == 0) {
+          inexact += !r.exact;
+          ambiguous += r.ambiguous.size();
+        }
+        worm.add(r);
+        lines.push_back(std::move(r.polyline));
+      }
+    }
+    pc::orient_sequence(lines);
+    std::size_t swaps = 0;
+    int first_end = 0;
+    double worst = 0.0, worst_sym = 0.0;
+    for (std::size_t f = 0; f < lines.size(); ++f) {
+      const float body = mid[f].length();
+      const double e = pc::mean_distance(lines[f], mid[f], 0.25f) / body;
+      const double es = 0.5 * (e + pc::mean_distance(mid[f], lines[f], 0.25f) / body);
+      err.push_back(e);
+      err_sym.push_back(es);
+      worst = std::max(worst, e);
+      worst_sym = std::max(worst_sym, es);
+      // Which end is first: +1 = the tail (slice 50), -1 = the head (slice 148).
+      const glm::vec3 p0 = lines[f].nodes.front().position;
+      const int end = glm::distance(p0, mid[f].nodes.front().position) < glm::distance(p0, mid[f].nodes.back().position) ? 1 : -1;
+      if (f == 0) first_end = end;
+      else if (end != first_end) ++swaps;
+    }
+    double mean = 0.0;
+    for (double e : err) mean += e;
+    mean /= static_cast<double>(err.size());
+    std::printf("worm: %zu frames x %zu points: polyline -> midline mean distance %.3f %% of the body length "
+                "(worst frame %.3f %%), symmetric worst %.3f %%; frames whose first node is not the same end as frame 0: %zu; "
+                "frames without exactly %d segments: %zu; ambiguous normals: %zu\n\n",
+                set.frames.size(), set.frames[0].size(), 100.0 * mean, 100.0 * worst, 100.0 * worst_sym, swaps,
+                segments, inexact, ambiguous);
+    std::printf("| cloud | points | neighbours | normals | orientation | surface | sdf | shift | clustering | polyline | total median ms | max ms |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    worm.print("Sibernetic worm (shell)", set.frames[0].size());
+    for (std::size_t count : synthetic) {
+      pc::WormShape shape;
+      shape.points = count;
+      Summary syn;
+      double e = 0.0;
+      for (int s = 0; s < 5; ++s) {
+        shape.seed = static_cast<std::uint32_t>(s + 1);
+        shape.phase = 0.7f * static_cast<float>(s);
+        const pc::SyntheticWorm w = pc::synthetic_worm(shape);
+        pc::SkeletonResult r = pc::point_cloud_skeleton(w.points, *backend, opt);
+        syn.add(r);
+        e = std::max<double>(e, pc::mean_distance(r.polyline, w.midline, 0.25f) / w.length);
+      }
+      const std::string label = "synthetic worm (worst error " + std::to_string(100.0 * e).substr(0, 5) + " %)";
+      syn.print(label.c_str(), count);
+    }
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "error: %s\n", ex.what());
+    return 1;
+  }
+  return 0;
+}
