@@ -4,12 +4,13 @@
 //
 // usage: sdfkit_pointcloud_bench [--data DIR] [--segments N] [--backend opencl|embree]
 //                                [--synthetic N,N,...] [--runs R] [--linkage average|single]
-//                                [--neighbours K]
+//                                [--neighbours K] [--bones 4,8,...] [--rotation procrustes|polyline]
 //   --data       a Sibernetic frame set (default: ../shared/worm beside the source tree)
 //   --synthetic  point counts of synthetic worms to time (default 2000,30000)
 //   --runs       repetitions of the whole frame set; the per-step medians are over all runs
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/pointcloud/pointcloud.hpp"
+#include "sdfkit/pointcloud/skinning.hpp"
 #include "sdfkit/reference/embree_backend.hpp"
 #ifdef SDFKIT_POINTCLOUD_BENCH_OPENCL
 #include "sdfkit/opencl/opencl_backend.hpp"
@@ -27,6 +28,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 namespace pc = sdfkit::pointcloud;
 
@@ -94,7 +97,9 @@ int main(int argc, char** argv) {
       "embree";
 #endif
   int segments = 16, runs = 1;
+  bool procrustes = true;
   std::vector<std::size_t> synthetic{2000, 30000};
+  std::vector<int> bone_counts{4, 6, 8, 12, 16, 20, 24, 32};
   pc::SkeletonOptions opt;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -105,8 +110,10 @@ int main(int argc, char** argv) {
     if (a == "--data") data = next();
     else if (a == "--segments") segments = std::stoi(next());
     else if (a == "--backend") backend_name = next();
+    else if (a == "--rotation") procrustes = next() != "polyline";
     else if (a == "--runs") runs = std::stoi(next());
     else if (a == "--neighbours") opt.neighbours = std::stoi(next());
+    else if (a == "--cluster-neighbours") opt.cluster_neighbours = std::stoi(next());
     else if (a == "--rays") opt.sdf.rays = std::stoi(next());
     else if (a == "--linkage") opt.linkage = next() == "single" ? pc::Linkage::Single : pc::Linkage::Average;
     else if (a == "--synthetic") {
@@ -115,6 +122,12 @@ int main(int argc, char** argv) {
       std::string tok;
       while (std::getline(ss, tok, ','))
         if (!tok.empty()) synthetic.push_back(std::stoul(tok));
+    } else if (a == "--bones") {
+      bone_counts.clear();
+      std::stringstream ss(next());
+      std::string tok;
+      while (std::getline(ss, tok, ','))
+        if (!tok.empty()) bone_counts.push_back(std::stoi(tok));
     } else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
@@ -188,6 +201,39 @@ int main(int argc, char** argv) {
       }
       const std::string label = "synthetic worm (worst error " + std::to_string(100.0 * e).substr(0, 5) + " %)";
       syn.print(label.c_str(), count);
+    }
+    // The ratio-error curve of compress-animation over the bone count, measured on the glb.
+    if (!bone_counts.empty()) {
+      const pc::FrameSet all = pc::read_frames(data, false);
+      const std::string glb = "/tmp/sdfkit_pointcloud_bench_" + std::to_string(::getpid()) + ".glb";
+      std::printf("\n| bones | glb bytes | ratio | RMSE | RMSE %% of length | max error | KG error %% | worst particle (frame) | skeletons s | fit s |\n");
+      std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+      for (int bones : bone_counts) {
+        pc::CompressionOptions co;
+        co.bones = bones;
+        co.frame_time = set.frame_time > 0.0 ? set.frame_time : 1.0;
+        co.skeleton.sdf = opt.sdf;
+        co.rotation = procrustes ? pc::CompressionOptions::Rotation::Procrustes : pc::CompressionOptions::Rotation::Polyline;
+        const pc::Compression c = pc::compress_animation(all.frames, set.frames, *backend, co);
+        const std::size_t bytes = pc::write_skinned_glb(c.animation, glb);
+        const auto played = pc::play_skinned_glb(glb);
+        double length = 0.0;
+        for (const auto& l : c.bones_per_frame) length += l.length();
+        length /= static_cast<double>(c.bones_per_frame.size());
+        const pc::CompressionReport r = pc::measure_compression(all.frames, played, bytes, c.animation.bone_count(), length);
+        std::size_t wf = 0, wi = 0;
+        float we = 0.0f;
+        for (std::size_t f = 0; f < played.size(); ++f)
+          for (std::size_t i = 0; i < played[f].size(); ++i)
+            if (glm::distance(played[f][i], all.frames[f][i]) > we) {
+              we = glm::distance(played[f][i], all.frames[f][i]);
+              wf = f;
+              wi = i;
+            }
+        std::printf("| %d | %zu | %.1f | %.3f | %.2f | %.2f | %.3f | %zu (%zu) | %.2f | %.2f |\n", bones, bytes, r.ratio, r.rmse,
+                    r.rmse_percent, r.max_error, r.kg_error, wi, wf, c.skeleton_ms / 1000.0, c.fit_ms / 1000.0);
+      }
+      std::remove(glb.c_str());
     }
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "error: %s\n", ex.what());

@@ -59,6 +59,20 @@ Neighbours k_nearest(std::span<const glm::vec3> points, int k) {
   return nb;
 }
 
+Neighbours first_neighbours(const Neighbours& nb, int k) {
+  Neighbours out;
+  out.k = std::clamp(k, 1, nb.k);
+  const std::size_t n = nb.k > 0 ? nb.index.size() / static_cast<std::size_t>(nb.k) : 0;
+  out.index.resize(n * static_cast<std::size_t>(out.k));
+  out.dist2.resize(out.index.size());
+  for (std::size_t i = 0; i < n; ++i)
+    for (int j = 0; j < out.k; ++j) {
+      out.index[i * out.k + j] = nb.index[i * nb.k + j];
+      out.dist2[i * out.k + j] = nb.dist2[i * nb.k + j];
+    }
+  return out;
+}
+
 std::vector<glm::vec3> pca_normals(std::span<const glm::vec3> points, const Neighbours& nb) {
   const std::size_t n = points.size();
   std::vector<glm::vec3> normals(n);

@@ -116,9 +116,15 @@ MergeTree::MergeTree(std::span<const glm::vec3> points, const Neighbours& connec
     }
     std::vector<std::uint32_t> version(n_, 0);
     Dsu dsu(n_);
-    using Item = std::tuple<float, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
-    for (const auto& [a, b] : edges) heap.emplace(dist(a, b), a, b, 0u, 0u);
+    struct Item {
+      float d;
+      std::uint32_t a, b, va, vb;
+      bool operator>(const Item& o) const { return d > o.d; }
+    };
+    std::vector<Item> store;
+    store.reserve(edges.size() * 3);
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> heap(std::greater<>{}, std::move(store));
+    for (const auto& [a, b] : edges) heap.push({dist(a, b), a, b, 0u, 0u});
     while (!heap.empty()) {
       const auto [d, a0, b0, va, vb] = heap.top();
       heap.pop();
@@ -143,7 +149,7 @@ MergeTree::MergeTree(std::span<const glm::vec3> points, const Neighbours& connec
       std::vector<std::uint32_t>().swap(adj[b]);
       for (std::uint32_t c : adj[a]) {
         const std::uint32_t x = std::min(a, c), y = std::max(a, c);
-        heap.emplace(dist(a, c), x, y, version[x], version[y]);
+        heap.push({dist(a, c), x, y, version[x], version[y]});
       }
     }
   }
@@ -406,6 +412,8 @@ float mean_distance(const Polyline& a, const Polyline& b, float step) {
 void validate_options(const SkeletonOptions& o) {
   if (o.neighbours < 4 || o.neighbours > 64)
     throw InputError("neighbour count must be in [4, 64] (got " + std::to_string(o.neighbours) + ")");
+  if (o.cluster_neighbours < 2 || o.cluster_neighbours > o.neighbours)
+    throw InputError("the clustering's neighbour count must be in [2, neighbours]");
   if (o.up_axis < 0 || o.up_axis > 2) throw InputError("up axis must be x, y or z");
   if (o.segments < 0) throw InputError("--segments must be at least 1");
   if (!(o.threshold >= 0.0f) || !std::isfinite(o.threshold)) throw InputError("--threshold must be a finite length >= 0");
@@ -443,10 +451,11 @@ SkeletonResult point_cloud_skeleton(std::span<const glm::vec3> points, SdfBacken
   lap("sdf");
   r.shifted = shift_inward(points, r.normals, r.sdf);
   lap("shift");
-  const MergeTree tree(r.shifted, nb, options.linkage);
+  const Neighbours graph = first_neighbours(nb, options.cluster_neighbours);
+  const MergeTree tree(r.shifted, graph, options.linkage);
   lap("clustering");
   if (options.segments > 0) {
-    SegmentSearch s = polyline_with_segments(r.shifted, r.sdf, tree, nb, options.segments);
+    SegmentSearch s = polyline_with_segments(r.shifted, r.sdf, tree, graph, options.segments);
     r.polyline = std::move(s.polyline);
     r.threshold = s.threshold;
     r.exact = s.exact;
@@ -458,7 +467,7 @@ SkeletonResult point_cloud_skeleton(std::span<const glm::vec3> points, SdfBacken
       t = static_cast<float>(sum / static_cast<double>(r.sdf.size()));
     }
     r.threshold = t;
-    r.polyline = order_clusters(r.shifted, r.sdf, tree.labels(t), nb);
+    r.polyline = order_clusters(r.shifted, r.sdf, tree.labels(t), graph);
   }
   lap("polyline");
   return r;

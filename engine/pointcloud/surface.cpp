@@ -109,6 +109,51 @@ std::vector<std::array<std::uint32_t, 3>> delaunay_2d(std::span<const float> xy_
   return result;
 }
 
+std::vector<std::array<std::uint32_t, 2>> delaunay_star(std::span<const float> xy) {
+  // The Voronoi cell of the origin: a square far outside the neighbours, clipped by the
+  // bisector half-plane x . q <= |q|^2 / 2 of every neighbour q. Each cell edge keeps the
+  // neighbour whose bisector made it (-1: the square, an unbounded side).
+  const std::size_t n = xy.size() / 2;
+  std::vector<std::array<std::uint32_t, 2>> star;
+  double reach = 0.0;
+  for (std::size_t j = 0; j < n; ++j) reach = std::max(reach, std::hypot(double(xy[2 * j]), double(xy[2 * j + 1])));
+  if (reach <= 0.0) return star;
+  const double box = 8.0 * reach;
+  struct V {
+    double x, y;
+    int label;  // the edge from this vertex to the next
+  };
+  std::vector<V> poly{{-box, -box, -1}, {box, -box, -1}, {box, box, -1}, {-box, box, -1}}, next;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double qx = xy[2 * j], qy = xy[2 * j + 1];
+    const double c = 0.5 * (qx * qx + qy * qy);
+    if (c <= 1e-12 * reach * reach) continue;  // a duplicate of the centre
+    next.clear();
+    const std::size_t m = poly.size();
+    for (std::size_t i = 0; i < m; ++i) {
+      const V& a = poly[i];
+      const V& b = poly[(i + 1) % m];
+      const double fa = a.x * qx + a.y * qy - c, fb = b.x * qx + b.y * qy - c;
+      const bool ina = fa <= 0.0, inb = fb <= 0.0;
+      if (ina) next.push_back(a);
+      if (ina != inb) {
+        const double u = fa / (fa - fb);
+        const V cut{a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), ina ? static_cast<int>(j) : a.label};
+        next.push_back(cut);
+      }
+    }
+    poly.swap(next);
+    if (poly.size() < 3) return star;
+  }
+  // Consecutive cell edges made by two neighbours i then j: the Delaunay triangle (0, i, j).
+  const std::size_t m = poly.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const int a = poly[i].label, b = poly[(i + 1) % m].label;
+    if (a >= 0 && b >= 0 && a != b) star.push_back({static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b)});
+  }
+  return star;
+}
+
 Mesh tangent_plane_surface(std::span<const glm::vec3> points, std::span<const glm::vec3> normals,
                            const Neighbours& nb, bool deduplicate) {
   const std::size_t n = points.size();
@@ -121,19 +166,13 @@ Mesh tangent_plane_surface(std::span<const glm::vec3> points, std::span<const gl
       const glm::vec3 u = glm::normalize(glm::cross(nrm, helper));
       const glm::vec3 v = glm::cross(nrm, u);  // (u, v, n) right-handed
       const auto ids = nb.of(i);
-      xy.assign(2 * (ids.size() + 1), 0.0f);
+      xy.assign(2 * ids.size(), 0.0f);
       for (std::size_t j = 0; j < ids.size(); ++j) {
         const glm::vec3 d = points[ids[j]] - points[i];
-        xy[2 * (j + 1)] = glm::dot(d, u);
-        xy[2 * (j + 1) + 1] = glm::dot(d, v);
+        xy[2 * j] = glm::dot(d, u);
+        xy[2 * j + 1] = glm::dot(d, v);
       }
-      for (const auto& t : delaunay_2d(xy)) {
-        if (t[0] != 0 && t[1] != 0 && t[2] != 0) continue;  // not in the point's star
-        auto global = [&](std::uint32_t local) {
-          return local == 0 ? static_cast<std::uint32_t>(i) : ids[local - 1];
-        };
-        stars[i].push_back({global(t[0]), global(t[1]), global(t[2])});
-      }
+      for (const auto& e : delaunay_star(xy)) stars[i].push_back({static_cast<std::uint32_t>(i), ids[e[0]], ids[e[1]]});
     }
   }, 256);
   Mesh mesh;
