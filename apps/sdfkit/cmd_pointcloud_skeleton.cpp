@@ -51,7 +51,8 @@ void add_pointcloud_skeleton_command(CLI::App& app) {
                   "Exactly N segments (N + 1 nodes) per frame: the clustering threshold is searched per frame")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--threshold", a->threshold, "Clustering distance threshold in model units (default: the mean SDF)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->excludes("--segments");
   cmd->add_option("--nodes", a->nodes, "Also write each polyline resampled at this many nodes (\"subdivided\")")
       ->check(CLI::Range(2, 100000));
   cmd->add_option("--neighbours", a->options.neighbours, "k nearest neighbours for normals, orientation and the surface")
@@ -69,7 +70,6 @@ void add_pointcloud_skeleton_command(CLI::App& app) {
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
     if (a->sdf.sdf.domain != SdfDomain::Vertex) throw InputError("point clouds use the per-point SDF (--per vertex)");
-    if (a->segments > 0 && a->threshold > 0.0f) throw InputError("--segments and --threshold exclude each other");
     const std::string ext = std::filesystem::path(a->output).extension().string();
     if (ext != ".json" && ext != ".JSON") throw InputError(a->output + ": the output must be a .json file");
     pointcloud::SkeletonOptions options = a->options;

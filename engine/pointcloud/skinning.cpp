@@ -104,7 +104,7 @@ std::array<float, 4> fit_weights(const std::vector<std::vector<glm::mat4>>& skin
     if (!feasible) continue;
     w /= w.sum();
     const double cost = w.dot(G * w) - 2.0 * h.dot(w) + yy;
-    if (cost < best_cost - 1e-12 * std::abs(best_cost)) {
+    if (cost < best_cost) {
       best_cost = cost;
       for (std::size_t k = 0; k < m; ++k) best[k] = static_cast<float>(w(static_cast<Eigen::Index>(k)));
     }
