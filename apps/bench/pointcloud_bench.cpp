@@ -18,7 +18,18 @@
 
 #include <glm/geometric.hpp>
 
+#ifdef SDFKIT_POINTCLOUD_BENCH_CGAL
+#include <CGAL/Mean_curvature_flow_skeletonization.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Surface_mesh.h>
+#include <boost/graph/graph_traits.hpp>
+#endif
+
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -61,6 +72,49 @@ std::vector<pc::Polyline> read_midlines(const std::string& path) {
   return lines;
 }
 
+#ifdef SDFKIT_POINTCLOUD_BENCH_CGAL
+// CGAL's mean curvature flow skeleton (contract_until_convergence spelled out) of a frame's
+// surface as the simulator's own membrane triangles (a closed mesh of the shell particles: the
+// best reconstruction a robust mesh method could hope for). Returns seconds; fills the mean
+// distance of the skeleton's vertices to the midline.
+double run_mcf(const std::vector<glm::vec3>& all, const std::vector<std::array<std::size_t, 3>>& tris,
+               const pc::Polyline& midline, double& mean_distance, std::size_t& nodes) {
+  using Kernel = CGAL::Simple_cartesian<double>;
+  using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
+  using Mcf = CGAL::Mean_curvature_flow_skeletonization<Mesh>;
+  std::vector<Kernel::Point_3> points;
+  for (const auto& p : all) points.emplace_back(p.x, p.y, p.z);
+  std::vector<std::vector<std::size_t>> polygons;
+  for (const auto& t : tris) polygons.push_back({t[0], t[1], t[2]});
+  CGAL::Polygon_mesh_processing::orient_polygon_soup(points, polygons);
+  Mesh tm;
+  CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, polygons, tm);
+  tm.collect_garbage();
+  const auto t0 = std::chrono::steady_clock::now();
+  Mcf mcf(tm);
+  const double original = CGAL::Polygon_mesh_processing::area(tm);
+  double last = 0.0;
+  for (std::size_t it = 0; it < mcf.max_iterations(); ++it) {
+    mcf.contract();
+    const double area = CGAL::Polygon_mesh_processing::area(mcf.meso_skeleton());
+    if (std::abs(last - area) / original < mcf.area_variation_factor()) break;
+    last = area;
+  }
+  Mcf::Skeleton skeleton;
+  mcf.convert_to_skeleton(skeleton);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  double sum = 0.0;
+  nodes = 0;
+  for (auto v : CGAL::make_range(vertices(skeleton))) {
+    const auto& p = skeleton[v].point;
+    sum += pc::distance_to_polyline(glm::vec3(p.x(), p.y(), p.z()), midline);
+    ++nodes;
+  }
+  mean_distance = nodes ? sum / static_cast<double>(nodes) : 0.0;
+  return seconds;
+}
+#endif
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -80,7 +134,7 @@ struct Summary {
   }
   void print(const char* label, std::size_t points) const {
     std::printf("| %s | %zu |", label, points);
-    for (const char* s : {"neighbours", "normals", "orientation", "surface", "sdf", "shift", "clustering", "polyline"})
+    for (const char* s : {"subsample", "neighbours", "normals", "orientation", "surface", "sdf", "shift", "clustering", "polyline"})
       std::printf(" %.2f |", steps.count(s) ? median(steps.at(s)) : 0.0);
     std::printf(" **%.1f** | %.1f |\n", median(totals), *std::max_element(totals.begin(), totals.end()));
   }
@@ -114,6 +168,7 @@ int main(int argc, char** argv) {
     else if (a == "--runs") runs = std::stoi(next());
     else if (a == "--neighbours") opt.neighbours = std::stoi(next());
     else if (a == "--cluster-neighbours") opt.cluster_neighbours = std::stoi(next());
+    else if (a == "--max-points") opt.max_points = std::stoul(next());
     else if (a == "--rays") opt.sdf.rays = std::stoi(next());
     else if (a == "--linkage") opt.linkage = next() == "single" ? pc::Linkage::Single : pc::Linkage::Average;
     else if (a == "--synthetic") {
@@ -183,8 +238,8 @@ int main(int argc, char** argv) {
                 "frames without exactly %d segments: %zu; ambiguous normals: %zu\n\n",
                 set.frames.size(), set.frames[0].size(), 100.0 * mean, 100.0 * worst, 100.0 * worst_sym, swaps,
                 segments, inexact, ambiguous);
-    std::printf("| cloud | points | neighbours | normals | orientation | surface | sdf | shift | clustering | polyline | total median ms | max ms |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("| cloud | points | subsample | neighbours | normals | orientation | surface | sdf | shift | clustering | polyline | total median ms | max ms |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     worm.print("Sibernetic worm (shell)", set.frames[0].size());
     for (std::size_t count : synthetic) {
       pc::WormShape shape;
@@ -201,7 +256,47 @@ int main(int argc, char** argv) {
       }
       const std::string label = "synthetic worm (worst error " + std::to_string(100.0 * e).substr(0, 5) + " %)";
       syn.print(label.c_str(), count);
+      if (opt.max_points == 0 && count > 4000) {  // the same clouds, subsampled to 4000 points
+        pc::SkeletonOptions sub = opt;
+        sub.max_points = 4000;
+        Summary ss;
+        double es = 0.0;
+        for (int s = 0; s < 5; ++s) {
+          shape.seed = static_cast<std::uint32_t>(s + 1);
+          shape.phase = 0.7f * static_cast<float>(s);
+          const pc::SyntheticWorm w = pc::synthetic_worm(shape);
+          pc::SkeletonResult r = pc::point_cloud_skeleton(w.points, *backend, sub);
+          ss.add(r);
+          es = std::max<double>(es, pc::mean_distance(r.polyline, w.midline, 0.25f) / w.length);
+        }
+        const std::string sl = "same, --max-points 4000 (worst error " + std::to_string(100.0 * es).substr(0, 5) + " %)";
+        ss.print(sl.c_str(), count);
+      }
     }
+#ifdef SDFKIT_POINTCLOUD_BENCH_CGAL
+    {
+      // CGAL's MCF on four frames' membrane meshes, beside the point-cloud method.
+      const pc::FrameSet all = pc::read_frames(data, false);
+      std::ifstream in(data + "/membranes.txt");
+      std::vector<std::array<std::size_t, 3>> tris;
+      std::string line;
+      while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream ls(line);
+        std::array<std::size_t, 3> t;
+        if (ls >> t[0] >> t[1] >> t[2]) tris.push_back(t);
+      }
+      std::printf("\n| CGAL MCF on the membrane mesh (%zu triangles) | frame | seconds | skeleton vertices | mean distance to the midline %% |\n|---|---|---|---|---|\n",
+                  tris.size());
+      for (std::size_t f : {0, 25, 50, 75}) {
+        if (f >= all.frames.size()) break;
+        double md = 0.0;
+        std::size_t nodes = 0;
+        const double sec = run_mcf(all.frames[f], tris, mid[f], md, nodes);
+        std::printf("| | %zu | %.3f | %zu | %.3f |\n", f, sec, nodes, 100.0 * md / mid[f].length());
+      }
+    }
+#endif
     // The ratio-error curve of compress-animation over the bone count, measured on the glb.
     if (!bone_counts.empty()) {
       const pc::FrameSet all = pc::read_frames(data, false);

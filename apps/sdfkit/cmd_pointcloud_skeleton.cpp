@@ -58,6 +58,11 @@ void add_pointcloud_skeleton_command(CLI::App& app) {
   cmd->add_option("--neighbours", a->options.neighbours, "k nearest neighbours for normals, orientation and the surface")
       ->check(CLI::Range(4, 64))
       ->capture_default_str();
+  cmd->add_option("--max-points", a->options.max_points,
+                  "Run on this many points drawn at random when the cloud has more (0 = all; 4000 keeps a 30k-point worm's "
+                  "polyline, bench/RESULTS.md)")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{1} << 40))
+      ->capture_default_str();
   cmd->add_option("--up-axis", a->up, "x | y | z: the topmost point along it seeds the normal orientation")
       ->check(CLI::IsMember({"x", "y", "z"}))
       ->capture_default_str();

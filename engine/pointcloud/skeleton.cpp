@@ -14,6 +14,7 @@
 #include <limits>
 #include <numeric>
 #include <queue>
+#include <random>
 #include <tuple>
 
 namespace sdfkit::pointcloud {
@@ -415,6 +416,7 @@ void validate_options(const SkeletonOptions& o) {
   if (o.cluster_neighbours < 2 || o.cluster_neighbours > o.neighbours)
     throw InputError("the clustering's neighbour count must be in [2, neighbours]");
   if (o.up_axis < 0 || o.up_axis > 2) throw InputError("up axis must be x, y or z");
+  if (o.max_points != 0 && o.max_points < 64) throw InputError("max points must be 0 (all) or at least 64");
   if (o.segments < 0) throw InputError("--segments must be at least 1");
   if (!(o.threshold >= 0.0f) || !std::isfinite(o.threshold)) throw InputError("--threshold must be a finite length >= 0");
   validate_options(o.sdf);
@@ -435,6 +437,24 @@ SkeletonResult point_cloud_skeleton(std::span<const glm::vec3> points, SdfBacken
     r.times.push_back({step, std::chrono::duration<double, std::milli>(t1 - t0).count()});
     t0 = t1;
   };
+  std::vector<glm::vec3> subsample;
+  if (options.max_points > 0 && points.size() > options.max_points) {
+    // A uniform random subset (partial Fisher-Yates with a fixed seed), kept in input order.
+    std::vector<std::uint32_t> idx(points.size());
+    std::iota(idx.begin(), idx.end(), 0u);
+    std::mt19937 rng(12345);
+    for (std::size_t i = 0; i < options.max_points; ++i) {
+      std::uniform_int_distribution<std::size_t> pick(i, idx.size() - 1);
+      std::swap(idx[i], idx[pick(rng)]);
+    }
+    idx.resize(options.max_points);
+    std::sort(idx.begin(), idx.end());
+    subsample.reserve(idx.size());
+    for (std::uint32_t i : idx) subsample.push_back(points[i]);
+    r.sample = std::move(idx);
+    points = subsample;
+    lap("subsample");
+  }
   const Neighbours nb = k_nearest(points, options.neighbours);
   lap("neighbours");
   const std::vector<glm::vec3> raw = pca_normals(points, nb);

@@ -6,6 +6,7 @@
 #include "device_policy.hpp"
 #include "scratch.hpp"
 
+#include "sdfkit/core/error.hpp"
 #include "sdfkit/pointcloud/pointcloud.hpp"
 #include "sdfkit/pointcloud/skinning.hpp"
 #ifdef SDFKIT_POINTCLOUD_TEST_OPENCL
@@ -18,6 +19,7 @@
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -147,9 +149,27 @@ TEST_P(PointcloudDevice, SyntheticWormsWithinOnePercentOfTheirLength) {
     EXPECT_GT(r.polyline.length(), 0.85f * w.length);
     // Radii: half the SDF, near the tube's radius mid-body.
     EXPECT_NEAR(r.polyline.nodes[6].radius, shape.max_radius, 0.25f * shape.max_radius);
-    // Step timings are all reported.
+    // Step timings are all reported (no subsample step without max_points).
     EXPECT_EQ(r.times.size(), 8u);
+    EXPECT_TRUE(r.sample.empty());
   }
+}
+
+TEST_P(PointcloudDevice, SubsampledLargeCloudKeepsItsMidline) {
+  pc::WormShape shape;
+  shape.points = 12000;
+  const pc::SyntheticWorm w = pc::synthetic_worm(shape);
+  pc::SkeletonOptions opt;
+  opt.segments = 12;
+  opt.max_points = 3000;
+  const pc::SkeletonResult r = pc::point_cloud_skeleton(w.points, *backend_, opt);
+  ASSERT_EQ(r.sample.size(), 3000u);
+  EXPECT_TRUE(std::is_sorted(r.sample.begin(), r.sample.end()));
+  EXPECT_EQ(r.sdf.size(), 3000u);
+  EXPECT_EQ(r.times.front().step, "subsample");
+  EXPECT_LT(pc::mean_distance(r.polyline, w.midline, 0.25f), 0.01f * w.length);
+  opt.max_points = 10;
+  EXPECT_THROW(pc::point_cloud_skeleton(w.points, *backend_, opt), sdfkit::InputError);
 }
 
 TEST_P(PointcloudDevice, EveryWormFrameWithinTwoPercentWithoutHeadTailSwap) {

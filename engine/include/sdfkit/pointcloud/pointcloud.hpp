@@ -167,6 +167,10 @@ struct SkeletonOptions {
   int neighbours = kDefaultNeighbours;
   int up_axis = 1;
   int cluster_neighbours = 6;  // the clustering's graph: the first of the k neighbours
+  // 0 = every point. Otherwise a cloud with more points runs the whole pipeline on this many,
+  // drawn uniformly at random (fixed seed): a 30k-point worm gives the same polyline from 4k
+  // points (bench/RESULTS.md) at a fraction of the time.
+  std::size_t max_points = 0;
   int segments = 0;  // 0 = threshold mode
   float threshold = 0.0f;  // used when segments == 0; 0 = the mean SDF
   Linkage linkage = Linkage::Average;
@@ -180,7 +184,8 @@ struct StepTime {
 };
 struct SkeletonResult {
   Polyline polyline;
-  std::vector<glm::vec3> normals;  // oriented
+  std::vector<std::uint32_t> sample;  // with max_points: the input indices used (else empty)
+  std::vector<glm::vec3> normals;  // oriented (per used point: see `sample`)
   std::vector<float> sdf;
   std::vector<glm::vec3> shifted;
   std::vector<std::uint32_t> ambiguous;
