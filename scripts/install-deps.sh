@@ -16,7 +16,7 @@ packages=(
   # OpenCL: ICD loader, headers, PoCL (CPU platform)
   ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
   # geometry and I/O
-  libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libeigen3-dev
+  libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libeigen3-dev libnanoflann-dev
   # reference ray caster (tests and benchmarks only)
   libembree-dev libtbb-dev
   # CLI, logging, tests, benchmarks

@@ -17,6 +17,8 @@ void add_bench_command(CLI::App& app);
 void add_skeleton_command(CLI::App& app);
 void add_smooth_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
+void add_pointcloud_skeleton_command(CLI::App& app);  // issue 14
+void add_compress_animation_command(CLI::App& app);   // issue 14
 #ifdef SDFKIT_CLI_HAS_RENDER
 void add_render_command(CLI::App& app);
 #endif
@@ -61,6 +63,8 @@ struct ResultValues {
 // smooths the values. Without `sdf`, values are required.
 ResultValues load_or_compute(const std::string& input, const SdfCliOptions* sdf,
                              const io::LoadOptions& load = {});
+// Writes `text` to `path` through a temporary file beside it (never a half-written output).
+void write_text_atomically(const std::string& path, const std::string& text);
 // Throws InputError unless `path` ends in .png (any case).
 void check_png_name(const std::string& path);
 

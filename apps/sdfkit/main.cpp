@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
   sdfkit::cli::add_skeleton_command(app);
   sdfkit::cli::add_smooth_command(app);
   sdfkit::cli::add_compare_command(app);
+  sdfkit::cli::add_pointcloud_skeleton_command(app);
+  sdfkit::cli::add_compress_animation_command(app);
 #ifdef SDFKIT_CLI_HAS_RENDER
   sdfkit::cli::add_render_command(app);
 #endif

@@ -3,6 +3,7 @@
 
 #include "arrays.hpp"
 #include "errors.hpp"
+#include "pointcloud.hpp"
 #include "session.hpp"
 
 #include "sdfkit/backends.hpp"
@@ -400,4 +401,5 @@ PYBIND11_MODULE(sdfkit, m) {
   sdfkit::python::bind_asset(m);
   sdfkit::python::bind_session(m);
   sdfkit::python::bind_functions(m);
+  sdfkit::python::bind_pointcloud(m);
 }
