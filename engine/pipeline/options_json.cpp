@@ -26,7 +26,7 @@ constexpr std::size_t member_count() {
 
 static_assert(member_count<SdfOptions>() == 4, "SdfOptions: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<BackendConfig>() == 10, "BackendConfig: options_to_json must write every member (the batch fingerprint is made of it)");
-static_assert(member_count<io::LoadOptions>() == 1, "io::LoadOptions: options_to_json must write every member (the batch fingerprint is made of it)");
+static_assert(member_count<io::LoadOptions>() == 4, "io::LoadOptions: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<io::WriteOptions>() == 3, "io::WriteOptions: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<ComputeRequest>() == 7, "ComputeRequest: options_to_json must write every member (the batch fingerprint is made of it)");
 
@@ -73,7 +73,11 @@ nlohmann::json options_object(const ComputeRequest& r) {
         {"cone_degrees", r.sdf.cone_degrees},
         {"per", r.sdf.domain == SdfDomain::Face ? "face" : "vertex"},
         {"false_hits", r.sdf.false_hit == FalseHitRule::Cgal ? "cgal" : "paper"}}},
-      {"load", {{"weld_tolerance", r.load.weld_tolerance}}},
+      {"load",
+       {{"weld_tolerance", r.load.weld_tolerance},
+        {"allow_external_paths", r.load.allow_external_paths},
+        {"max_triangles", r.load.max_triangles},
+        {"max_file_size", r.load.max_file_size}}},
       {"write", {{"color", r.write.color}, {"normalized", r.write.normalized}, {"overlays", overlays}}},
       {"smooth_rings", r.smooth_rings}};
 }
