@@ -174,8 +174,8 @@ BackendChoice choose_backend(const BackendConfig& config, const SdfOptions& sdf,
       set.empty() ? std::string() : " (" + flags_of(set) + (set.size() > 1 ? " are options" : " is an option") +
                                         " of the " + to_string(option_info(set[0]).used_by) + " backend)";
   if (candidates.empty())
-    throw DeviceError("no built backend honours " + flags_of(set) + " (this sdfkit has " +
-                      std::to_string(built.size()) + " backend(s))");
+    throw DeviceError(built.empty() ? std::string("this sdfkit was built without the Vulkan and OpenCL backends")
+                                    : "no backend of this build honours " + flags_of(set));
   const auto first_device = [&](BackendKind k, bool gpu_only) -> const DeviceListing* {
     for (const DeviceListing& d : devices)
       if (d.backend == to_string(k) && d.usable && (!gpu_only || d.gpu) && selects(config.device, d)) return &d;
