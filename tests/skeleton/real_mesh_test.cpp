@@ -7,6 +7,8 @@
 // quantities over the whole data set (engine/skeleton/README.md).
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/core/weld.hpp"
 #include "sdfkit/core/topology.hpp"
 #include "sdfkit/core/union_find.hpp"
 #include "sdfkit/io/asset.hpp"
@@ -17,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "analytic.hpp"
+#include "validate.hpp"  // engine/skeleton (private): split_non_manifold
 
 #include <cmath>
 #include <map>
@@ -217,4 +220,36 @@ TEST(SkeletonRealMeshes, OpenMeshIsRefusedWithAClearError) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("boundary edges"), std::string::npos) << e.what();
   }
+}
+
+// Two boxes touching along one edge (the four triangles there share it): the split gives two
+// closed edge-manifold boxes again, with the edge's two vertices duplicated, and the skeleton
+// has one part per box.
+TEST(SkeletonRealMeshes, BoxesTouchingAlongAnEdgeAreSplitIntoTwoSolids) {
+  const Mesh a = shapes::box(1.0f, 1.0f, 1.0f, 2);
+  Mesh m = a;
+  // The second box: shifted by (1, 1, 0) (centred boxes of size 1 meet along x = y = 0.5).
+  const std::uint32_t offset = static_cast<std::uint32_t>(m.positions.size());
+  for (const glm::vec3& p : a.positions) m.positions.push_back(p + glm::vec3(1.0f, 1.0f, 0.0f));
+  for (const Triangle& t : a.triangles) m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  m = weld(m.positions, m.triangles, 1e-6f).mesh;
+  const MeshReport before = analyze(m);
+  ASSERT_GT(before.non_manifold_edges, 0u);
+  ASSERT_EQ(before.boundary_edges, 0u);
+  ASSERT_EQ(before.components, 1u);
+  const sk::detail::ManifoldSplit split = sk::detail::split_non_manifold(m, "test");
+  ASSERT_TRUE(split.applied);
+  const MeshReport after = analyze(split.mesh);
+  EXPECT_EQ(after.non_manifold_edges, 0u);
+  EXPECT_EQ(after.boundary_edges, 0u);
+  EXPECT_EQ(after.components, 2u);
+  EXPECT_EQ(split.mesh.positions.size(), m.positions.size() + 3);  // the edge's 3 vertices (n = 2)
+  for (std::size_t v = 0; v < split.mesh.positions.size(); ++v)
+    EXPECT_EQ(split.mesh.positions[v], m.positions[split.original[v]]);
+  const sk::Skeleton s = extract(m);
+  EXPECT_EQ(parts(s), 2);
+  std::vector<int> count(m.positions.size(), 0);
+  for (const sk::Node& n : s.nodes)
+    for (std::uint32_t v : n.vertices) ++count[v];
+  for (int c : count) EXPECT_EQ(c, 1);
 }
