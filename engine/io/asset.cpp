@@ -78,11 +78,15 @@ const char* format_name(Format format) {
   return "unknown";
 }
 
+float weld_tolerance_for(const LoadOptions& options, std::span<const glm::vec3> positions) {
+  return options.weld_tolerance >= 0.0f ? options.weld_tolerance : default_weld_tolerance(positions);
+}
+
 Asset load_asset(const std::string& path, const LoadOptions& options) {
   const Format format = format_from_path(path);
   if (format == Format::Txt)
     detail::fail(path, ".txt files hold values, not meshes (load .gltf, .glb, .obj, .off or .ply)");
-  if (!(options.weld_tolerance >= 0.0f) || !std::isfinite(options.weld_tolerance))
+  if (!std::isfinite(options.weld_tolerance))
     throw InputError("weld tolerance must be a finite number >= 0");
 
   detail::check_regular_file(path);
@@ -115,7 +119,8 @@ Asset load_asset(const std::string& path, const LoadOptions& options) {
     asset.input_triangles = std::move(input.triangles);
   }
 
-  WeldResult welded = weld(asset.input_positions, asset.input_triangles, options.weld_tolerance);
+  asset.weld_tolerance = weld_tolerance_for(options, asset.input_positions);
+  WeldResult welded = weld(asset.input_positions, asset.input_triangles, asset.weld_tolerance);
   asset.mesh = std::move(welded.mesh);
   asset.input_to_welded = std::move(welded.input_to_welded);
   return asset;

@@ -45,7 +45,8 @@ io::Asset load_input(const std::string& path, const io::LoadOptions& options) {
   asset.format = io::Format::Off;
   asset.input_positions = mesh.positions;
   asset.input_triangles = mesh.triangles;
-  WeldResult welded = weld(mesh.positions, mesh.triangles, options.weld_tolerance);
+  asset.weld_tolerance = io::weld_tolerance_for(options, mesh.positions);
+  WeldResult welded = weld(mesh.positions, mesh.triangles, asset.weld_tolerance);
   asset.mesh = std::move(welded.mesh);
   asset.input_to_welded = std::move(welded.input_to_welded);
   return asset;

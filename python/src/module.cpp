@@ -150,17 +150,19 @@ values: (V,) per welded vertex (per="vertex") or (F,) per face (per="face"), mod
 
   m.def(
       "load",
-      [](const std::string& path, float weld_tolerance) {
-        if (!(weld_tolerance >= 0.0f))
-          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
+      [](const std::string& path, std::optional<float> weld_tolerance) {
+        if (weld_tolerance && !(*weld_tolerance >= 0.0f))
+          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(*weld_tolerance));
         py::gil_scoped_release unlocked;
-        return std::make_shared<io::Asset>(load_input(path, io::LoadOptions{weld_tolerance}));
+        return std::make_shared<io::Asset>(
+            load_input(path, io::LoadOptions{weld_tolerance.value_or(io::LoadOptions::kDefaultWeld)}));
       },
-      "path"_a, "weld_tolerance"_a = 0.0f,
+      "path"_a, "weld_tolerance"_a = py::none(),
       R"doc(Loads a mesh file (.gltf .glb .obj .off .ply) or a built-in shape ("builtin:sphere",
 "builtin:torus", "builtin:capsule", "builtin:slab", "builtin:tube") and returns an sdfkit.Asset.
 
-Positions closer than weld_tolerance (model units; 0 = bitwise-equal only) are welded into one
+Positions closer than weld_tolerance (model units; 0 = bitwise-equal only; None = 1e-6 of the
+bounding box, which merges seam duplicates that differ by float rounding) are welded into one
 vertex. Raises sdfkit.InputError "<path>: <problem>" for a missing or malformed file.)doc");
 }
 
@@ -255,7 +257,7 @@ void bind_functions(py::module_& m) {
       [](const std::string& input, const std::optional<std::string>& output, Session* session,
          const std::string& backend, const std::string& device, int views, int resolution, std::size_t memory_cap,
          const std::string& per, int rays, float cone, const std::string& false_hits, int smooth, bool normalize,
-         bool color, float weld_tolerance) {
+         bool color, std::optional<float> weld_tolerance) {
         ComputeRequest request;
         request.input = input;
         request.output = output.value_or("");
@@ -264,9 +266,9 @@ void bind_functions(py::module_& m) {
         request.smooth_rings = smooth;
         request.write.color = color;
         request.write.normalized = normalize;
-        if (!(weld_tolerance >= 0.0f))
-          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
-        request.load.weld_tolerance = weld_tolerance;
+        if (weld_tolerance && !(*weld_tolerance >= 0.0f))
+          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(*weld_tolerance));
+        request.load.weld_tolerance = weld_tolerance.value_or(io::LoadOptions::kDefaultWeld);
         const BackendConfig config = make_config(backend, device, views, resolution, memory_cap);
         if (session && (config.kind != BackendKind::Auto || !device.empty() || views || resolution || memory_cap))
           throw InputError("compute_file: pass either session or backend options (backend, device, views, "
@@ -289,7 +291,7 @@ void bind_functions(py::module_& m) {
       "input"_a, "output"_a = py::none(), py::kw_only(), "session"_a = nullptr, "backend"_a = "auto",
       "device"_a = "", "views"_a = 0, "resolution"_a = 0, "memory_cap"_a = 0, "per"_a = "vertex",
       "rays"_a = kDefaultRays, "cone"_a = kDefaultConeDegrees, "false_hits"_a = "paper", "smooth"_a = 0,
-      "normalize"_a = false, "color"_a = true, "weld_tolerance"_a = 0.0f,
+      "normalize"_a = false, "color"_a = true, "weld_tolerance"_a = py::none(),
       R"doc(What `sdfkit compute INPUT -o OUTPUT` does: load, compute, optionally smooth, write
 atomically. Returns the JSON report (`sdfkit compute --json`) as a dict: input, output, ok,
 counts {input_vertices, input_faces, welded_vertices, points, filled_points}, backend, device,

@@ -32,10 +32,19 @@ Format format_from_path(const std::string& path);
 const char* format_name(Format format);
 
 struct LoadOptions {
+  // weld_tolerance's default: sdfkit::default_weld_tolerance of the input positions (1e-6 of the
+  // larger of their bounding-box diagonal and largest coordinate), which merges seam duplicates
+  // that differ by float rounding.
+  static constexpr float kDefaultWeld = -1.0f;
   // Positions closer than this (model units, after glTF node transforms) become one welded
-  // vertex; 0 welds bitwise-equal positions only. See sdfkit::weld.
-  float weld_tolerance = 0.0f;
+  // vertex; 0 welds bitwise-equal positions only; negative (kDefaultWeld) = the default above.
+  // See sdfkit::weld.
+  float weld_tolerance = kDefaultWeld;
 };
+
+// The tolerance `options` asks for on these positions (model units): weld_tolerance itself, or
+// the default when it is negative.
+float weld_tolerance_for(const LoadOptions& options, std::span<const glm::vec3> positions);
 
 struct Asset {
   std::string path;
@@ -51,6 +60,8 @@ struct Asset {
   Mesh mesh;
   // For each input vertex, its welded vertex in `mesh`.
   std::vector<std::uint32_t> input_to_welded;
+  // The welding tolerance used (model units; 0 = bitwise-equal positions).
+  float weld_tolerance = 0.0f;
   // Things skipped or changed while loading ("skipped 2 LINES primitives"), also logged.
   std::vector<std::string> warnings;
   // Format-specific data the writers need to write the input back (for glTF: the parsed model
