@@ -81,6 +81,12 @@ ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& 
 
   io::Asset asset = load_input(request.input, request.load);
   report.stages.push_back({"load", clock.lap_ms()});
+  for (StageTiming s : asset.load_stages) {
+    s.nested = true;
+    report.stages.push_back(s);
+  }
+  const auto sample = [&](const char* stage) { report.memory.push_back({stage, resident_memory()}); };
+  sample("weld");
   report.input_vertices = asset.input_positions.size();
   report.input_faces = asset.input_triangles.size();
   report.welded_vertices = asset.mesh.positions.size();
@@ -90,10 +96,13 @@ ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& 
   report.backend = backend.name();
   report.device = backend.device_name();
   report.stages.push_back({"device", clock.lap_ms()});
+  sample("device");
   backend.set_mesh(asset.mesh);
   const double set_mesh_ms = clock.lap_ms();
+  sample("set_mesh");
   SdfField field = compute_sdf(backend, asset.mesh, request.sdf);
   const double compute_ms = clock.lap_ms();
+  sample("sdf");
   const auto backend_stages = backend.last_timings();
   if (backend_stages.empty()) {
     report.stages.push_back({"prepare", set_mesh_ms});
@@ -113,12 +122,14 @@ ComputeReport run_compute(const ComputeRequest& request, const BackendProvider& 
     smooth.rings = request.smooth_rings;
     field.values = smooth_field(asset.mesh, field.domain, field.values, smooth);
     report.stages.push_back({"smooth", clock.lap_ms()});
+    sample("smooth");
   }
   report.summary = summarize(field.values);
 
   if (!request.output.empty()) {
     io::write_field(request.output, asset, field, request.write);
     report.stages.push_back({"write", clock.lap_ms()});
+    sample("write");
   }
   return report;
 }

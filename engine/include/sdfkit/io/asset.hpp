@@ -62,6 +62,8 @@ struct Asset {
   std::vector<std::uint32_t> input_to_welded;
   // The welding tolerance used (model units; 0 = bitwise-equal positions).
   float weld_tolerance = 0.0f;
+  // How long loading took: "read" (parse and validate the file), "weld".
+  std::vector<StageTiming> load_stages;
   // Things skipped or changed while loading ("skipped 2 LINES primitives"), also logged.
   std::vector<std::string> warnings;
   // Format-specific data the writers need to write the input back (for glTF: the parsed model
