@@ -55,20 +55,24 @@ public:
     head_.assign(size, kNone);
     mask_ = size - 1;
   }
-  // Thread-safe: pushes vertex v on its bucket's chain.
+  // Pushes vertex v on its bucket's chain. Inserted in decreasing index order, every chain
+  // lists its vertices in increasing order: a lookup for vertex i stops at the first index >= i,
+  // and the first match it meets is the earliest (so 20k copies of one point cost 20k steps,
+  // not 20k^2).
   void insert(std::uint64_t hash, std::uint32_t v) {
-    std::atomic_ref<std::uint32_t> head(head_[hash & mask_]);
-    std::uint32_t old = head.load(std::memory_order_relaxed);
-    do {
-      next_[v] = old;
-    } while (!head.compare_exchange_weak(old, v, std::memory_order_release, std::memory_order_relaxed));
+    std::uint32_t& head = head_[hash & mask_];
+    next_[v] = head;
+    head = v;
   }
   // Brings the bucket's head into the cache ahead of use: the table is far larger than the
   // caches, and overlapping these misses is what makes the passes fast.
   void prefetch(std::uint64_t hash) const { __builtin_prefetch(&head_[hash & mask_]); }
+  // Calls visit(v) for the bucket's vertices v < below, in increasing order, until it returns
+  // true.
   template <class Visit>
-  void for_each(std::uint64_t hash, Visit&& visit) const {
-    for (std::uint32_t v = head_[hash & mask_]; v != kNone; v = next_[v]) visit(v);
+  void for_each_below(std::uint64_t hash, std::uint32_t below, Visit&& visit) const {
+    for (std::uint32_t v = head_[hash & mask_]; v != kNone && v < below; v = next_[v])
+      if (visit(v)) return;
   }
 
 private:
@@ -109,10 +113,11 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
     const glm::vec3 d = a - b;
     return glm::dot(d, d) <= tol2;
   };
-  // Calls visit(j) for every vertex j in the buckets a match of p can lie in.
+  // Calls visit(j) for the vertices j < i in the buckets a match of p can lie in, each
+  // bucket's in increasing order until visit returns true.
   Buckets buckets(n);
-  const auto for_candidates = [&](const glm::vec3& p, auto&& visit) {
-    if (exact) return buckets.for_each(hash_of(p), visit);
+  const auto for_candidates = [&](const glm::vec3& p, std::uint32_t i, auto&& visit) {
+    if (exact) return buckets.for_each_below(hash_of(p), i, visit);
     const double t = static_cast<double>(tolerance);
     std::int64_t lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
@@ -121,17 +126,17 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
     }
     for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
       for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-        for (std::int64_t z = lo[2]; z <= hi[2]; ++z) buckets.for_each(cell_hash(x, y, z), visit);
+        for (std::int64_t z = lo[2]; z <= hi[2]; ++z) buckets.for_each_below(cell_hash(x, y, z), i, visit);
   };
 
   constexpr std::size_t kGrain = 1 << 15;
   constexpr std::size_t kAhead = 16;  // prefetch distance, vertices
-  parallel_for(n, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      if (i + kAhead < e) buckets.prefetch(hash_of(positions[i + kAhead]));
-      buckets.insert(hash_of(positions[i]), static_cast<std::uint32_t>(i));
-    }
-  }, kGrain);
+  // Sequential, in decreasing order (see Buckets::insert); the hashes are computed ahead on all
+  // threads only where that pays.
+  for (std::size_t i = n; i-- > 0;) {
+    if (i >= kAhead) buckets.prefetch(hash_of(positions[i - kAhead]));
+    buckets.insert(hash_of(positions[i]), static_cast<std::uint32_t>(i));
+  }
 
   // rep[i]: the input vertex that i welds to. First pass, in parallel: a vertex with no earlier
   // vertex within the tolerance is its own; the others (kNone) are resolved in input order.
@@ -143,7 +148,10 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
       if (i + kAhead < e) buckets.prefetch(hash_of(positions[i + kAhead]));
       const glm::vec3& p = positions[i];
       bool earlier = false;
-      for_candidates(p, [&](std::uint32_t j) { earlier = earlier || (j < i && same(positions[j], p)); });
+      for_candidates(p, static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
+        earlier = earlier || same(positions[j], p);
+        return earlier;
+      });
       rep[i] = earlier ? kNone : static_cast<std::uint32_t>(i);
       local += earlier;
     }
@@ -156,8 +164,13 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
       if (rep[i] != kNone) continue;
       const glm::vec3& p = positions[i];
       std::uint32_t best = kNone;
-      for_candidates(p, [&](std::uint32_t j) {
-        if (j < i && j < best && rep[j] == j && same(positions[j], p)) best = j;
+      for_candidates(p, static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
+        if (j >= best) return true;  // a later bucket's candidates can only be earlier
+        if (rep[j] == j && same(positions[j], p)) {
+          best = j;
+          return true;
+        }
+        return false;
       });
       rep[i] = best == kNone ? static_cast<std::uint32_t>(i) : best;
     }

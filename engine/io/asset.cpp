@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -105,16 +106,22 @@ FileData read_file(const std::string& path) {
 
 namespace {
 
-// Bytes a process may still use: MemAvailable, capped by a cgroup v2 or v1 memory limit.
+// Bytes a process may still use: MemAvailable, capped by a cgroup v2 or v1 memory limit and by
+// SDFKIT_MEMORY_LIMIT (bytes) where set.
 std::uint64_t available_memory() {
   std::uint64_t avail = 0;
+  if (const char* env = std::getenv("SDFKIT_MEMORY_LIMIT"); env && *env) {
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(env, &end, 10);
+    if (end && *end == '\0' && v > 0) avail = v;
+  }
   if (std::ifstream m("/proc/meminfo"); m) {
     std::string key;
     std::uint64_t kib = 0;
     std::string unit;
     while (m >> key >> kib >> unit)
       if (key == "MemAvailable:") {
-        avail = kib * 1024;
+        if (avail == 0 || kib * 1024 < avail) avail = kib * 1024;
         break;
       }
   }

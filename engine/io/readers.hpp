@@ -62,7 +62,7 @@ FileData read_file(const std::string& path);
 // more than the Y GiB of memory available" when the estimated memory of a whole run (input,
 // welded copy, BVH, device buffers, output; `bytes_per_vertex` / `bytes_per_triangle` measured
 // on a 13M-triangle run) exceeds the memory this process can get (MemAvailable, and the cgroup's
-// limit where one is set). Readers call it as soon as they know the counts, before allocating.
+// limit where one is set, and SDFKIT_MEMORY_LIMIT in bytes where set). Readers call it as soon as they know the counts, before allocating.
 void check_mesh_fits(const std::string& path, std::uint64_t vertices, std::uint64_t triangles);
 
 // Readers: `data` is the whole file. Each throws InputError naming `path` on malformed input;

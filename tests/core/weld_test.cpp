@@ -115,3 +115,17 @@ TEST(Weld, HugeAndTinyTolerancesStayCorrect) {
   EXPECT_EQ(weld(p, {}, 1e-38f).mesh.positions.size(), 4u);
   EXPECT_EQ(weld(p, {}, 1e31f).mesh.positions.size(), 1u);
 }
+
+TEST(Weld, ManyCopiesOfOnePointWeldToTheFirst) {
+  // 200k copies (a degenerate export): every lookup stops at the first copy, so this is linear
+  // (quadratic would be 2e10 steps, far past the test's timeout).
+  std::vector<glm::vec3> p(200000, glm::vec3(0.5f, -0.25f, 2.0f));
+  p.push_back({1, 1, 1});
+  p.insert(p.begin() + 7, glm::vec3(0.5f, -0.25f, 2.0f + 5e-7f));
+  for (float tol : {0.0f, 1e-6f}) {
+    const WeldResult w = weld(p, {}, tol);
+    EXPECT_EQ(w.mesh.positions.size(), tol > 0 ? 2u : 3u);
+    EXPECT_EQ(w.input_to_welded[199999], 0u);
+    EXPECT_EQ(w.input_to_welded[7], tol > 0 ? 0u : 1u);
+  }
+}

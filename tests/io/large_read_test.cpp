@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <charconv>
+#include <cstdlib>
 
 namespace sdfkit {
 namespace {
@@ -81,6 +82,34 @@ TEST(LargeRead, BinaryPlyRoundTripsPositionsAndValues) {
   ASSERT_EQ(back.asset.input_positions, m.positions);
   ASSERT_EQ(back.asset.input_triangles, m.triangles);
   ASSERT_EQ(back.values, field.values);
+}
+
+// A mesh that cannot fit is refused from the counts, before its arrays are allocated: the
+// limit here is SDFKIT_MEMORY_LIMIT (as on a machine with 1 MB free).
+TEST(LargeRead, AMeshTooLargeForMemoryIsRefusedFromItsCounts) {
+  const Mesh& m = big_mesh();
+  io::Asset a;
+  a.input_positions = m.positions;
+  a.input_triangles = m.triangles;
+  a.mesh = m;
+  a.input_to_welded.resize(m.positions.size());
+  for (std::uint32_t i = 0; i < a.input_to_welded.size(); ++i) a.input_to_welded[i] = i;
+  SdfField field;
+  field.values.assign(m.positions.size(), 1.0f);
+  ScratchDir dir;
+  const std::string ply = dir.path("big.ply");
+  io::write_field(ply, a, field);
+  std::string obj;
+  for (int i = 0; i < 20000; ++i) obj += "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n";
+  const std::string obj_path = dir.write("big.obj", obj);
+  ASSERT_NO_THROW(io::load_asset(ply));
+  ASSERT_EQ(setenv("SDFKIT_MEMORY_LIMIT", "1000000", 1), 0);
+  test::expect_input_error([&] { io::load_asset(ply); }, ply,
+                           "a mesh of 163842 vertices and 327680 triangles needs about");
+  test::expect_input_error([&] { io::load_asset(obj_path); }, obj_path,
+                           "a mesh of 60000 vertices and 20000 triangles needs about");
+  unsetenv("SDFKIT_MEMORY_LIMIT");
+  EXPECT_NO_THROW(io::load_asset(obj_path));
 }
 
 }  // namespace
