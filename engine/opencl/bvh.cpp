@@ -268,10 +268,11 @@ struct Builder {
   Bvh build_all() {
     const std::size_t n = refs.size();
     const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-    // Parts of ~1/16 of the triangles per thread keep the threads busy to the end.
-    const std::size_t task_size = n < kParallelBelow || threads == 1
-                                      ? n
-                                      : std::max<std::size_t>(kParallelBelow / 2, n / (16 * threads));
+    // Large meshes: parts of ~1/16 of the triangles per thread keep the threads busy to the
+    // end. Small ones: the root's two halves, as the top costs more than imbalance there.
+    const std::size_t task_size = n < kParallelBelow || threads == 1 ? n
+                                  : n < (std::size_t{1} << 20)        ? (n + 1) / 2
+                                                                      : n / (16 * threads);
     std::vector<Top> top;
     std::vector<int> tasks;
     split_top(top, tasks, 0, n, 0, task_size);
