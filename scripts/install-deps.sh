@@ -25,6 +25,8 @@ packages=(
   pybind11-dev python3-numpy python3-dev
   # test data: CGAL's mesh data set (data.tar.gz)
   libcgal-demo
+  # the Slurm test (scripts/slurm-local.sh): a single-node cluster on localhost
+  slurm-wlm munge
 )
 # Node.js runs the Khronos glTF validator in the tests; keep a newer one if the machine has it.
 if ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi

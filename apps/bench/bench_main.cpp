@@ -2,6 +2,7 @@
 // Embree reference, CGAL's sdf_values and (with --meshlab) MeshLab's GPU SDF filter on the same
 // meshes in one run; writes Markdown and JSON.
 #include "bench_runner.hpp"
+#include "huge_bench.hpp"
 
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/process.hpp"
@@ -45,7 +46,8 @@ int main(int argc, char** argv) {
   BenchOptions o;
   std::vector<std::string> meshes;
   std::string json_out, md_out, work = "bench-work";
-  bool large = false, no_cgal = false;
+  bool large = false, no_cgal = false, huge = false, generate_only = false;
+  HugeOptions huge_options;
   app.add_option("MESHES", meshes, "Meshes to time (default: CGAL's elephant, armadillo, bunny00, refined_elephant)");
   app.add_option("--backends", o.backends, "Backends: vulkan opencl embree")->delimiter(',');
   app.add_option("--rays", o.rays, "Rays per point for the ray backends");
@@ -57,6 +59,13 @@ int main(int argc, char** argv) {
   app.add_option("--device", o.device, "GPU device selector");
   app.add_flag("--profile", o.profile, "Per-pass GPU timestamps (Vulkan) in the stage table");
   app.add_flag("--large", large, "Add bunny00 subdivided (~150k vertices) and armadillo subdivided twice (~416k)");
+  app.add_flag("--huge", huge,
+               "Instead of the table: CGAL's armadillo subdivided to levels 3 and 4 (3.3M, 13.3M triangles) as binary "
+               "PLY and OBJ, each through `sdfkit compute --json` in its own process: time and peak memory per stage");
+  app.add_option("--huge-levels", huge_options.levels, "--huge: subdivision levels")->delimiter(',')->check(CLI::Range(0, 6));
+  app.add_option("--huge-formats", huge_options.formats, "--huge: ply, obj")->delimiter(',');
+  app.add_option("--huge-backend", huge_options.backend, "--huge: the backend of the runs");
+  app.add_flag("--generate-only", generate_only, "--huge: only write the meshes");
   app.add_flag("--meshlab", o.meshlab, "Also time MeshLab's GPU SDF filter (meshlabserver, xvfb-run)");
   app.add_flag("--no-cgal", no_cgal, "Skip CGAL's sdf_values");
   app.add_option("--smooth", o.smooth_rings, "k of the k-ring smoothing timing (0 = off)");
@@ -77,6 +86,27 @@ int main(int argc, char** argv) {
 
   try {
     fs::create_directories(work);
+    if (huge) {
+      huge_options.work_dir = work;
+      huge_options.rays = o.rays;
+      huge_options.sdfkit = self_dir() + "/sdfkit";
+      if (!fs::exists(huge_options.sdfkit)) huge_options.sdfkit = self_dir() + "/../sdfkit";
+      if (generate_only) {
+        generate_huge_meshes(huge_options);
+        return 0;
+      }
+      std::string table;
+      auto j = run_huge(huge_options, table);
+      const std::string md = "Machine: " + cpu_name() + ", " + std::to_string(std::thread::hardware_concurrency()) +
+                             " hardware threads.\n\n" + table;
+      std::printf("%s", md.c_str());
+      if (!md_out.empty()) sdfkit::io::write_file_atomically(md_out, [&](std::ostream& os) { os << md; });
+      if (!json_out.empty()) {
+        j["machine"] = cpu_name();
+        sdfkit::io::write_file_atomically(json_out, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+      }
+      return 0;
+    }
     std::vector<BenchMesh> list;
     if (meshes.empty())
       list = default_meshes(work, large);

@@ -98,7 +98,7 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--views", a->views, "Views of the mesh in the picture")->check(CLI::Range(1, 64));
   cmd->add_option("--width", a->width, "Picture width in pixels")->check(CLI::Range(64, 8192));
   cmd->add_option("--height", a->height, "Picture height in pixels")->check(CLI::Range(64, 8192));
-  cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units)")
+  cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units; default 1e-6 of the bounding box, 0 = bitwise-equal only)")
       ->check(CLI::NonNegativeNumber);
   add_asset_options(*cmd, a->load);
   cmd->callback([a] {

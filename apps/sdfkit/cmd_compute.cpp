@@ -33,7 +33,7 @@ void add_sdf_options(CLI::App& cmd, SdfCliOptions& o, const std::string& views_f
   cmd.add_option("--accel", o.backend_config.accel, "OpenCL acceleration structure: bvh (default) | octree")
       ->check(CLI::IsMember({"bvh", "octree"}));
   cmd.add_flag("--profile", o.backend_config.profile, "Time each pass on the device");
-  cmd.add_option("--weld-tolerance", o.load.weld_tolerance, "Weld positions closer than this (model units)")
+  cmd.add_option("--weld-tolerance", o.load.weld_tolerance, "Weld positions closer than this (model units; default 1e-6 of the bounding box, 0 = bitwise-equal only)")
       ->check(CLI::NonNegativeNumber);
   add_asset_options(cmd, o.load);
 }

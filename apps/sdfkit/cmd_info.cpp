@@ -13,9 +13,9 @@ void add_info_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Print counts and topology of a mesh");
   auto path = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
-  auto tolerance = std::make_shared<float>(0.0f);
+  auto tolerance = std::make_shared<float>(io::LoadOptions::kDefaultWeld);
   cmd->add_option("MESH", *path, "Mesh file (.gltf .glb .obj .off .ply) or builtin:NAME")->required();
-  cmd->add_option("--weld-tolerance", *tolerance, "Weld positions closer than this (model units)")
+  cmd->add_option("--weld-tolerance", *tolerance, "Weld positions closer than this (model units; default 1e-6 of the bounding box, 0 = bitwise-equal only)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", *json, "Print JSON instead of text");
   auto limits = std::make_shared<io::LoadOptions>();

@@ -81,7 +81,7 @@ void add_smooth_command(CLI::App& app) {
   cmd->add_option("--threads", a->smooth.threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   cmd->add_flag("--normalize", a->write.normalized, "Write values normalised to [0, 1]");
   cmd->add_flag("--no-color", a->no_color, "Do not write COLOR_0 / PLY colours");
-  cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units)")
+  cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units; default 1e-6 of the bounding box, 0 = bitwise-equal only)")
       ->check(CLI::NonNegativeNumber);
   add_asset_options(*cmd, a->load);
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");

@@ -1,95 +1,202 @@
 #include "sdfkit/core/weld.hpp"
 
+#include "sdfkit/core/parallel.hpp"
+
 #include <glm/geometric.hpp>
 
+#include <algorithm>
+#include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
-#include <unordered_map>
 
 namespace sdfkit {
 namespace {
 
-struct BitsKey {
-  std::uint32_t x, y, z;
-  bool operator==(const BitsKey&) const = default;
-};
-struct BitsHash {
-  std::size_t operator()(const BitsKey& k) const {
-    std::uint64_t h = k.x * 0x9E3779B97F4A7C15ull;
-    h ^= (k.y + 0x7F4A7C15ull + (h << 6) + (h >> 2)) * 0xBF58476D1CE4E5B9ull;
-    h ^= (k.z + 0x94D049BBull + (h << 6) + (h >> 2)) * 0x94D049BB133111EBull;
-    return static_cast<std::size_t>(h ^ (h >> 31));
-  }
-};
+constexpr std::uint32_t kNone = UINT32_MAX;
+// A grid cell is this many tolerances wide: the +-tolerance box of a point then overlaps one
+// cell per axis in 15 cases of 16, so a lookup visits ~1.2 cells (27 with cells of 1 tolerance).
+constexpr double kCellInTolerances = 16.0;
 
-std::uint32_t bits(float f) {
+std::uint32_t float_bits(float f) {
   if (f == 0.0f) f = 0.0f;  // -0 and +0 weld
-  std::uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
+  return std::bit_cast<std::uint32_t>(f);
 }
 
-struct CellKey {
-  std::int64_t x, y, z;
-  bool operator==(const CellKey&) const = default;
-};
-struct CellHash {
-  std::size_t operator()(const CellKey& k) const {
-    return static_cast<std::size_t>((k.x * 73856093) ^ (k.y * 19349663) ^ (k.z * 83492791));
+std::uint64_t mix(std::uint64_t h) {
+  h ^= h >> 33;
+  h *= 0xFF51AFD7ED558CCDull;
+  h ^= h >> 33;
+  h *= 0xC4CEB9FE1A85EC53ull;
+  return h ^ (h >> 33);
+}
+
+std::uint64_t cell_hash(std::int64_t x, std::int64_t y, std::int64_t z) {
+  return mix(static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ull ^
+             static_cast<std::uint64_t>(y) * 0xBF58476D1CE4E5B9ull ^
+             static_cast<std::uint64_t>(z) * 0x94D049BB133111EBull);
+}
+
+// Grid cell coordinate, clamped so that +-1 never overflows (a clamped cell holds many points,
+// which only costs time: matches are decided by distance, never by cell).
+std::int64_t cell_of(double v) {
+  constexpr double kLimit = 4.0e18;
+  v = std::clamp(v, -kLimit, kLimit);  // NaN never reaches here: inputs are validated finite
+  const auto t = static_cast<std::int64_t>(v);  // floor without a libm call (no SSE4.1 by default)
+  return t - static_cast<std::int64_t>(static_cast<double>(t) > v);
+}
+
+// A hash table of chains: bucket -> first vertex, next[vertex] -> the next vertex in that
+// bucket. Vertices of different cells may share a bucket; lookups compare positions.
+class Buckets {
+public:
+  explicit Buckets(std::size_t n) : next_(n, kNone) {
+    const std::size_t size = std::bit_ceil(std::max<std::size_t>(2 * n, 64));
+    head_.assign(size, kNone);
+    mask_ = size - 1;
   }
+  // Pushes vertex v on its bucket's chain. Inserted in decreasing index order, every chain
+  // lists its vertices in increasing order: a lookup for vertex i stops at the first index >= i,
+  // and the first match it meets is the earliest (so 20k copies of one point cost 20k steps,
+  // not 20k^2).
+  void insert(std::uint64_t hash, std::uint32_t v) {
+    std::uint32_t& head = head_[hash & mask_];
+    next_[v] = head;
+    head = v;
+  }
+  // Brings the bucket's head into the cache ahead of use: the table is far larger than the
+  // caches, and overlapping these misses is what makes the passes fast.
+  void prefetch(std::uint64_t hash) const { __builtin_prefetch(&head_[hash & mask_]); }
+  // Calls visit(v) for the bucket's vertices v < below, in increasing order, until it returns
+  // true.
+  template <class Visit>
+  void for_each_below(std::uint64_t hash, std::uint32_t below, Visit&& visit) const {
+    for (std::uint32_t v = head_[hash & mask_]; v != kNone && v < below; v = next_[v])
+      if (visit(v)) return;
+  }
+
+private:
+  std::vector<std::uint32_t> head_, next_;
+  std::size_t mask_ = 0;
 };
 
 }  // namespace
 
+float default_weld_tolerance(std::span<const glm::vec3> positions) {
+  if (positions.empty()) return 0.0f;
+  const Aabb box = bounding_box(positions);
+  const float magnitude = std::max({std::abs(box.min.x), std::abs(box.min.y), std::abs(box.min.z),
+                                    std::abs(box.max.x), std::abs(box.max.y), std::abs(box.max.z)});
+  const float t = 1e-6f * std::max(box.diagonal(), magnitude);
+  return std::isfinite(t) ? t : 0.0f;
+}
+
 WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> triangles,
                 float tolerance) {
+  const std::size_t n = positions.size();
+  const bool exact = !(tolerance > 0.0f);
+  const double cell = exact ? 1.0 : kCellInTolerances * static_cast<double>(tolerance);
+  const double inv_cell = 1.0 / cell;
+  const float tol2 = tolerance * tolerance;
+
+  // Exact: one bucket per bit pattern. Tolerance: the cell's hash.
+  const auto hash_of = [&](const glm::vec3& p) {
+    if (exact)
+      return mix((static_cast<std::uint64_t>(float_bits(p.x)) << 32 | float_bits(p.y)) ^
+                 (static_cast<std::uint64_t>(float_bits(p.z)) * 0x9E3779B97F4A7C15ull));
+    return cell_hash(cell_of(p.x * inv_cell), cell_of(p.y * inv_cell), cell_of(p.z * inv_cell));
+  };
+  const auto same = [&](const glm::vec3& a, const glm::vec3& b) {
+    if (exact)
+      return float_bits(a.x) == float_bits(b.x) && float_bits(a.y) == float_bits(b.y) &&
+             float_bits(a.z) == float_bits(b.z);
+    const glm::vec3 d = a - b;
+    return glm::dot(d, d) <= tol2;
+  };
+  // Calls visit(j) for the vertices j < i in the buckets a match of p can lie in, each
+  // bucket's in increasing order until visit returns true.
+  Buckets buckets(n);
+  const auto for_candidates = [&](const glm::vec3& p, std::uint32_t i, auto&& visit) {
+    if (exact) return buckets.for_each_below(hash_of(p), i, visit);
+    const double t = static_cast<double>(tolerance);
+    std::int64_t lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = cell_of((static_cast<double>(p[a]) - t) * inv_cell);
+      hi[a] = cell_of((static_cast<double>(p[a]) + t) * inv_cell);
+    }
+    for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+        for (std::int64_t z = lo[2]; z <= hi[2]; ++z) buckets.for_each_below(cell_hash(x, y, z), i, visit);
+  };
+
+  constexpr std::size_t kGrain = 1 << 15;
+  constexpr std::size_t kAhead = 16;  // prefetch distance, vertices
+  // Sequential, in decreasing order (see Buckets::insert); the hashes are computed ahead on all
+  // threads only where that pays.
+  for (std::size_t i = n; i-- > 0;) {
+    if (i >= kAhead) buckets.prefetch(hash_of(positions[i - kAhead]));
+    buckets.insert(hash_of(positions[i]), static_cast<std::uint32_t>(i));
+  }
+
+  // rep[i]: the input vertex that i welds to. First pass, in parallel: a vertex with no earlier
+  // vertex within the tolerance is its own; the others (kNone) are resolved in input order.
+  std::vector<std::uint32_t> rep(n);
+  std::atomic<std::size_t> pending{0};
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    std::size_t local = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      if (i + kAhead < e) buckets.prefetch(hash_of(positions[i + kAhead]));
+      const glm::vec3& p = positions[i];
+      bool earlier = false;
+      for_candidates(p, static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
+        earlier = earlier || same(positions[j], p);
+        return earlier;
+      });
+      rep[i] = earlier ? kNone : static_cast<std::uint32_t>(i);
+      local += earlier;
+    }
+    pending += local;
+  }, kGrain);
+  if (pending > 0) {
+    // Greedy in input order: i joins the earliest earlier vertex within the tolerance that is
+    // itself a welded vertex (all rep[j], j < i, are final here).
+    for (std::size_t i = 0; i < n; ++i) {
+      if (rep[i] != kNone) continue;
+      const glm::vec3& p = positions[i];
+      std::uint32_t best = kNone;
+      for_candidates(p, static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
+        if (j >= best) return true;  // a later bucket's candidates can only be earlier
+        if (rep[j] == j && same(positions[j], p)) {
+          best = j;
+          return true;
+        }
+        return false;
+      });
+      rep[i] = best == kNone ? static_cast<std::uint32_t>(i) : best;
+    }
+  }
+
+  // Number the welded vertices in input order; map every input vertex.
   WeldResult r;
-  r.input_to_welded.resize(positions.size());
-  if (tolerance <= 0.0f) {
-    std::unordered_map<BitsKey, std::uint32_t, BitsHash> seen;
-    seen.reserve(positions.size());
-    for (std::size_t i = 0; i < positions.size(); ++i) {
-      const glm::vec3& p = positions[i];
-      const BitsKey key{bits(p.x), bits(p.y), bits(p.z)};
-      auto [it, inserted] = seen.try_emplace(key, static_cast<std::uint32_t>(r.mesh.positions.size()));
-      if (inserted) r.mesh.positions.push_back(p);
-      r.input_to_welded[i] = it->second;
+  r.input_to_welded.resize(n);
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (rep[i] == i) r.input_to_welded[i] = count++;
+  r.mesh.positions.resize(count);
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (rep[i] == i) r.mesh.positions[r.input_to_welded[i]] = positions[i];
+      else r.input_to_welded[i] = r.input_to_welded[rep[i]];
     }
-  } else {
-    // Grid of cell size `tolerance`: a match lies in the 27 cells around the point.
-    std::unordered_map<CellKey, std::vector<std::uint32_t>, CellHash> grid;
-    const double inv = 1.0 / tolerance;
-    const float tol2 = tolerance * tolerance;
-    for (std::size_t i = 0; i < positions.size(); ++i) {
-      const glm::vec3& p = positions[i];
-      const CellKey c{static_cast<std::int64_t>(std::floor(p.x * inv)),
-                      static_cast<std::int64_t>(std::floor(p.y * inv)),
-                      static_cast<std::int64_t>(std::floor(p.z * inv))};
-      std::uint32_t match = UINT32_MAX;
-      for (int dx = -1; dx <= 1 && match == UINT32_MAX; ++dx)
-        for (int dy = -1; dy <= 1 && match == UINT32_MAX; ++dy)
-          for (int dz = -1; dz <= 1 && match == UINT32_MAX; ++dz) {
-            auto it = grid.find({c.x + dx, c.y + dy, c.z + dz});
-            if (it == grid.end()) continue;
-            for (std::uint32_t w : it->second) {
-              const glm::vec3 d = r.mesh.positions[w] - p;
-              if (glm::dot(d, d) <= tol2 && (match == UINT32_MAX || w < match)) match = w;
-            }
-          }
-      if (match == UINT32_MAX) {
-        match = static_cast<std::uint32_t>(r.mesh.positions.size());
-        r.mesh.positions.push_back(p);
-        grid[c].push_back(match);
+  }, kGrain);
+  r.mesh.triangles.resize(triangles.size());
+  parallel_for(triangles.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t f = b; f < e; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t idx = triangles[f][k];
+        r.mesh.triangles[f][k] = idx < n ? r.input_to_welded[idx] : idx;
       }
-      r.input_to_welded[i] = match;
-    }
-  }
-  r.mesh.triangles.reserve(triangles.size());
-  for (const Triangle& t : triangles) {
-    Triangle w = t;
-    for (auto& idx : w) idx = idx < positions.size() ? r.input_to_welded[idx] : idx;
-    r.mesh.triangles.push_back(w);
-  }
+  }, kGrain);
   return r;
 }
 

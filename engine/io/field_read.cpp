@@ -104,12 +104,13 @@ FieldFile read_field(const std::string& path, ValuesRequired required, const Loa
 }
 
 std::vector<float> read_values_txt(const std::string& path) {
-  const std::string data = detail::read_file(path);
+  const detail::FileData file = detail::read_file(path);
+  const std::string_view data = file.view();
   std::vector<float> values;
   std::size_t line_no = 0, pos = 0;
   while (pos < data.size()) {
     std::size_t end = data.find('\n', pos);
-    if (end == std::string::npos) end = data.size();
+    if (end == std::string_view::npos) end = data.size();
     ++line_no;
     std::string_view line(data.data() + pos, end - pos);
     pos = end + 1;

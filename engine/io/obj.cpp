@@ -2,84 +2,185 @@
 // `v/vt/vn` (1-based; negative = relative to the vertices read so far), polygons
 // fan-triangulated. Every other statement (vt, vn, g, o, s, usemtl, mtllib, ...) is ignored;
 // line and point elements are counted in a warning.
+//
+// Parsed in parallel: the file is cut at line breaks into one chunk per thread; a first pass
+// counts each chunk's vertices and triangles (so the arrays are allocated once, at their final
+// size, after a memory check), a second parses every chunk into its own range of them. Errors
+// are those of the earliest chunk, as a sequential reader would report them.
 
 #include "readers.hpp"
 #include "text_cursor.hpp"
 
+#include "sdfkit/core/parallel.hpp"
+
+#include <exception>
+#include <thread>
 #include <vector>
 
 namespace sdfkit::io::detail {
+namespace {
 
-RawMesh read_obj(const std::string& path, std::string_view data) {
-  TextCursor c(data, path);
-  RawMesh out;
-  std::vector<std::int64_t> face_vertices;  // per triangle corner, 0-based, unchecked
-  std::vector<std::int64_t> corner_raw;
+struct Chunk {
+  std::size_t begin = 0, end = 0;  // byte range, whole lines
+  std::size_t vertices = 0, triangles = 0;
+  std::size_t vertex_offset = 0, triangle_offset = 0;  // where its output goes
   std::size_t lines_skipped = 0, points_skipped = 0, faces_skipped = 0;
+  std::exception_ptr error;
+};
 
-  while (!c.at_end()) {
-    if (c.at_line_end()) {
-      c.next_line();
+bool is_blank(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\f' || ch == '\v'; }
+
+// First pass over one chunk: statements counted without parsing numbers (a face's corners are
+// its whitespace-separated tokens before a '#').
+void count_chunk(std::string_view data, Chunk& c) {
+  std::size_t p = c.begin;
+  while (p < c.end) {
+    while (p < c.end && is_blank(data[p])) ++p;
+    std::size_t eol = data.find('\n', p);
+    if (eol == std::string_view::npos || eol > c.end) eol = c.end;
+    if (p + 1 < eol && is_blank(data[p + 1])) {
+      if (data[p] == 'v') {
+        ++c.vertices;
+      } else if (data[p] == 'f') {
+        std::size_t corners = 0;
+        for (std::size_t q = p + 1; q < eol && data[q] != '#';) {
+          while (q < eol && is_blank(data[q])) ++q;
+          if (q >= eol || data[q] == '#') break;
+          ++corners;
+          while (q < eol && !is_blank(data[q])) ++q;
+        }
+        if (corners >= 3) c.triangles += corners - 2;
+      }
+    }
+    p = eol + 1;
+  }
+}
+
+// Second pass: parses the chunk into positions / triangle corners (0-based, unchecked against
+// the vertex count: a face may name a vertex defined further down).
+void parse_chunk(const std::string& path, std::string_view data, Chunk& c, std::vector<glm::vec3>& positions,
+                 std::vector<Triangle>& triangles) {
+  TextCursor cur(data.substr(0, c.end), path, c.begin);
+  std::size_t v_out = c.vertex_offset, t_out = c.triangle_offset;
+  std::int64_t corner_raw[3];
+  while (!cur.at_end()) {
+    if (cur.at_line_end()) {
+      cur.next_line();
       continue;
     }
-    const std::string_view key = c.word();
+    const std::string_view key = cur.word();
     if (key == "v") {
       glm::vec3 p;
       for (int k = 0; k < 3; ++k) {
-        if (!c.try_float(p[k]))
-          c.expected("coordinate " + std::to_string(k + 1) + " of vertex " +
-                     std::to_string(out.positions.size() + 1));
+        if (!cur.try_float(p[k]))
+          cur.expected("coordinate " + std::to_string(k + 1) + " of vertex " + std::to_string(v_out + 1));
       }
-      out.positions.push_back(p);
+      if (v_out >= c.vertex_offset + c.vertices) cur.error("a vertex the first pass did not count");
+      positions[v_out++] = p;
     } else if (key == "f") {
-      corner_raw.clear();
-      const auto count = static_cast<std::int64_t>(out.positions.size());
-      while (!c.at_line_end()) {
+      const auto count = static_cast<std::int64_t>(v_out);  // vertices read so far
+      std::size_t n = 0;
+      while (!cur.at_line_end()) {
         std::int64_t index = 0;
-        if (!c.try_int(index, /*allow_slash=*/true))
-          c.expected("a face corner (v, v/vt, v//vn or v/vt/vn)");
-        if (index == 0) c.error("vertex index 0 in a face (OBJ indices start at 1)");
+        if (!cur.try_int(index, /*allow_slash=*/true)) cur.expected("a face corner (v, v/vt, v//vn or v/vt/vn)");
+        if (index == 0) cur.error("vertex index 0 in a face (OBJ indices start at 1)");
         const std::int64_t resolved = index > 0 ? index - 1 : count + index;
         if (resolved < 0)
-          c.error("relative vertex index " + std::to_string(index) +
-                  " points before the first vertex");
-        corner_raw.push_back(resolved);
-        c.skip_token();  // "/vt/vn"
-      }
-      if (corner_raw.size() < 3) {
-        ++faces_skipped;
-      } else {
-        for (std::size_t k = 1; k + 1 < corner_raw.size(); ++k) {
-          face_vertices.push_back(corner_raw[0]);
-          face_vertices.push_back(corner_raw[k]);
-          face_vertices.push_back(corner_raw[k + 1]);
+          cur.error("relative vertex index " + std::to_string(index) + " points before the first vertex");
+        if (resolved > static_cast<std::int64_t>(UINT32_MAX) - 1)
+          cur.error("vertex index " + std::to_string(index) + " is out of range");
+        cur.skip_token();  // "/vt/vn"
+        // Fan: corner 0 stays, each new corner closes a triangle with the previous one.
+        if (n < 3) {
+          corner_raw[n] = resolved;
+        } else {
+          corner_raw[1] = corner_raw[2];
+          corner_raw[2] = resolved;
         }
+        ++n;
+        if (n >= 3 && t_out >= c.triangle_offset + c.triangles) cur.error("a face the first pass did not count");
+        if (n >= 3)
+          triangles[t_out++] = Triangle{static_cast<std::uint32_t>(corner_raw[0]),
+                                        static_cast<std::uint32_t>(corner_raw[1]),
+                                        static_cast<std::uint32_t>(corner_raw[2])};
       }
+      if (n < 3) ++c.faces_skipped;
     } else if (key == "l") {
-      ++lines_skipped;
+      ++c.lines_skipped;
     } else if (key == "p") {
-      ++points_skipped;
+      ++c.points_skipped;
     }
-    c.next_line();
+    cur.next_line();
+  }
+}
+
+}  // namespace
+
+RawMesh read_obj(const std::string& path, std::string_view data) {
+  // Chunks of at least 4 MiB, cut after a line break.
+  const std::size_t threads = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t parts = std::max<std::size_t>(1, std::min(threads, data.size() / (std::size_t{4} << 20)));
+  std::vector<Chunk> chunks;
+  std::size_t begin = 0;
+  for (std::size_t k = 1; k <= parts && begin < data.size(); ++k) {
+    std::size_t end = k == parts ? data.size() : data.size() * k / parts;
+    if (end < data.size()) {
+      const std::size_t nl = data.find('\n', std::max(end, begin));
+      end = nl == std::string_view::npos ? data.size() : nl + 1;
+    }
+    Chunk c;
+    c.begin = begin;
+    c.end = end;
+    chunks.push_back(c);
+    begin = end;
+  }
+  if (chunks.empty()) chunks.emplace_back();
+
+  parallel_for(chunks.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) count_chunk(data, chunks[k]);
+  }, 1);
+  std::size_t nv = 0, nt = 0;
+  for (Chunk& c : chunks) {
+    c.vertex_offset = nv;
+    c.triangle_offset = nt;
+    nv += c.vertices;
+    nt += c.triangles;
+  }
+  if (nv > UINT32_MAX) fail(path, "too many vertices");
+  check_mesh_fits(path, nv, nt);
+
+  RawMesh out;
+  out.positions.resize(nv);
+  out.triangles.resize(nt);
+  parallel_for(chunks.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      try {
+        parse_chunk(path, data, chunks[k], out.positions, out.triangles);
+      } catch (...) {
+        chunks[k].error = std::current_exception();
+      }
+    }
+  }, 1);
+  std::size_t lines_skipped = 0, points_skipped = 0, faces_skipped = 0;
+  for (const Chunk& c : chunks) {
+    if (c.error) std::rethrow_exception(c.error);
+    lines_skipped += c.lines_skipped;
+    points_skipped += c.points_skipped;
+    faces_skipped += c.faces_skipped;
   }
 
   // Checked at the end: a face may name a vertex defined further down.
-  const auto nv = static_cast<std::int64_t>(out.positions.size());
-  out.triangles.resize(face_vertices.size() / 3);
-  for (std::size_t i = 0; i < face_vertices.size(); ++i) {
-    if (face_vertices[i] >= nv)
-      fail(path, "triangle " + std::to_string(i / 3) + " uses vertex " +
-                     std::to_string(face_vertices[i] + 1) + " but the file has " +
-                     std::to_string(nv) + " vertices");
-    out.triangles[i / 3][i % 3] = static_cast<std::uint32_t>(face_vertices[i]);
-  }
+  for (std::size_t f = 0; f < out.triangles.size(); ++f)
+    for (const std::uint32_t v : out.triangles[f])
+      if (v >= nv)
+        fail(path, "triangle " + std::to_string(f) + " uses vertex " + std::to_string(std::uint64_t{v} + 1) +
+                       " but the file has " + std::to_string(nv) + " vertices");
   if (lines_skipped > 0)
     out.warnings.push_back("skipped " + std::to_string(lines_skipped) + " line elements (l)");
   if (points_skipped > 0)
     out.warnings.push_back("skipped " + std::to_string(points_skipped) + " point elements (p)");
   if (faces_skipped > 0)
-    out.warnings.push_back("skipped " + std::to_string(faces_skipped) +
-                           " faces with fewer than 3 vertices");
+    out.warnings.push_back("skipped " + std::to_string(faces_skipped) + " faces with fewer than 3 vertices");
   return out;
 }
 

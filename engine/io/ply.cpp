@@ -6,8 +6,11 @@
 #include "readers.hpp"
 #include "text_cursor.hpp"
 
+#include "sdfkit/core/parallel.hpp"
+
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <optional>
 #include <vector>
@@ -144,59 +147,6 @@ double min_row_bytes(const PlyElement& e, PlyEncoding enc) {
   return bytes;
 }
 
-// Reads binary values of either byte order.
-class BinaryCursor {
-public:
-  BinaryCursor(const std::string& path, std::string_view data, std::size_t start, bool swap)
-      : path_(path), data_(data), pos_(start), swap_(swap) {}
-
-  double scalar(PlyType t) {
-    switch (t) {
-      case PlyType::Int8: return static_cast<double>(raw<std::int8_t>());
-      case PlyType::UInt8: return static_cast<double>(raw<std::uint8_t>());
-      case PlyType::Int16: return static_cast<double>(raw<std::int16_t>());
-      case PlyType::UInt16: return static_cast<double>(raw<std::uint16_t>());
-      case PlyType::Int32: return static_cast<double>(raw<std::int32_t>());
-      case PlyType::UInt32: return static_cast<double>(raw<std::uint32_t>());
-      case PlyType::Float32: return static_cast<double>(raw<float>());
-      case PlyType::Float64: return raw<double>();
-    }
-    return 0.0;
-  }
-
-  void skip(std::size_t bytes, const std::string& what) {
-    if (bytes > data_.size() - pos_) truncated(what);
-    pos_ += bytes;
-  }
-
-  void set_context(const std::string* what) { what_ = what; }
-
-  [[noreturn]] void truncated(const std::string& what) const {
-    fail(path_, "unexpected end of file while reading " + what);
-  }
-
-private:
-  template <typename T>
-  T raw() {
-    if (sizeof(T) > data_.size() - pos_) truncated(what_ ? *what_ : std::string("the data"));
-    unsigned char bytes[sizeof(T)];
-    std::memcpy(bytes, data_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    if (swap_) {
-      for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(bytes[i], bytes[sizeof(T) - 1 - i]);
-    }
-    T value;
-    std::memcpy(&value, bytes, sizeof(T));
-    return value;
-  }
-
-  const std::string& path_;
-  std::string_view data_;
-  std::size_t pos_;
-  bool swap_;
-  const std::string* what_ = nullptr;
-};
-
 // One element reader for both encodings: `Source` provides scalar(type) (and skip for binary).
 struct AsciiSource {
   TextCursor& c;
@@ -216,13 +166,6 @@ struct AsciiSource {
     c.skip_blank(false);
     if (c.word().empty()) c.expected("a value in " + what);
   }
-};
-
-struct BinarySource {
-  BinaryCursor& b;
-  const std::string& what;
-  double scalar(PlyType t) { return b.scalar(t); }
-  void skip_scalar(PlyType t) { b.skip(type_size(t), what); }
 };
 
 template <typename Source>
@@ -313,9 +256,211 @@ void read_elements(const std::string& path, const PlyHeader& h, std::int64_t ver
                            " faces with fewer than 3 vertices");
 }
 
+
+// --- Binary: each element's rows are decoded by a loop over a precomputed property table (no
+// per-value dispatch through a cursor, no strings); fixed-size rows (vertices) in parallel.
+
+template <typename T>
+T load_raw(const char* p, bool swap) {
+  unsigned char bytes[sizeof(T)];
+  std::memcpy(bytes, p, sizeof(T));
+  if (swap) std::reverse(bytes, bytes + sizeof(T));
+  T value;
+  std::memcpy(&value, bytes, sizeof(T));
+  return value;
+}
+
+double load_value(const char* p, PlyType t, bool swap) {
+  switch (t) {
+    case PlyType::Int8: return static_cast<double>(load_raw<std::int8_t>(p, swap));
+    case PlyType::UInt8: return static_cast<double>(load_raw<std::uint8_t>(p, swap));
+    case PlyType::Int16: return static_cast<double>(load_raw<std::int16_t>(p, swap));
+    case PlyType::UInt16: return static_cast<double>(load_raw<std::uint16_t>(p, swap));
+    case PlyType::Int32: return static_cast<double>(load_raw<std::int32_t>(p, swap));
+    case PlyType::UInt32: return static_cast<double>(load_raw<std::uint32_t>(p, swap));
+    case PlyType::Float32: return static_cast<double>(load_raw<float>(p, swap));
+    case PlyType::Float64: return load_raw<double>(p, swap);
+  }
+  return 0.0;
+}
+
+// An index as stored: integral types exactly, floats only when they hold an integer.
+std::int64_t load_index(const char* p, PlyType t, bool swap) {
+  switch (t) {
+    case PlyType::Int32: return load_raw<std::int32_t>(p, swap);
+    case PlyType::UInt32: return load_raw<std::uint32_t>(p, swap);
+    default: break;
+  }
+  const double v = load_value(p, t, swap);
+  if (!(v >= -1e18 && v <= 1e18) || v != std::floor(v)) return -1;
+  return static_cast<std::int64_t>(v);
+}
+
+void read_binary(const std::string& path, const PlyHeader& h, std::int64_t vertex_count,
+                 std::string_view data, const FileData* file, RawMesh& out) {
+  const bool swap = (h.encoding == PlyEncoding::BinaryBig) != (std::endian::native == std::endian::big);
+  std::size_t pos = h.data_start;
+  std::size_t skipped_faces = 0;
+  std::vector<std::uint32_t> corners;
+  for (const PlyElement& e : h.elements) {
+    const bool is_vertex = e.name == "vertex";
+    const bool is_face = e.name == "face";
+    const std::string what = "element '" + e.name + "'";
+    const auto truncated = [&] { fail(path, "unexpected end of file while reading " + what); };
+    // Byte offset of each scalar in a row (rows without lists), and where lists are.
+    bool fixed = true;
+    std::size_t row_bytes = 0;
+    int xyz[3] = {-1, -1, -1}, face_list = -1, quality = -1;
+    std::vector<std::size_t> offset(e.properties.size(), 0);
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const PlyProperty& p = e.properties[i];
+      offset[i] = row_bytes;
+      if (p.is_list) {
+        fixed = false;
+      } else {
+        row_bytes += type_size(p.type);
+      }
+      const int k = static_cast<int>(i);
+      if ((is_vertex || is_face) && !p.is_list && p.name == "quality") quality = k;
+      if (is_vertex && !p.is_list) {
+        if (p.name == "x") xyz[0] = k;
+        if (p.name == "y") xyz[1] = k;
+        if (p.name == "z") xyz[2] = k;
+      }
+      if (is_face && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) face_list = k;
+    }
+    if (is_vertex && (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0))
+      fail(path, "the vertex element has no x, y and z properties");
+    if (is_face && face_list < 0) fail(path, "the face element has no list property 'vertex_indices'");
+    const auto count = static_cast<std::size_t>(e.count);
+
+    if (fixed) {
+      if (row_bytes > 0 && count > (data.size() - pos) / row_bytes) truncated();
+      const char* base = data.data() + pos;
+      if (is_vertex) {
+        out.positions.resize(count);
+        if (quality >= 0) out.vertex_quality.resize(count);
+        const PlyType tx = e.properties[static_cast<std::size_t>(xyz[0])].type;
+        const bool packed_floats = !swap && row_bytes == 12 && offset[static_cast<std::size_t>(xyz[0])] == 0 &&
+                                   offset[static_cast<std::size_t>(xyz[1])] == 4 &&
+                                   offset[static_cast<std::size_t>(xyz[2])] == 8 && tx == PlyType::Float32 &&
+                                   e.properties[static_cast<std::size_t>(xyz[1])].type == PlyType::Float32 &&
+                                   e.properties[static_cast<std::size_t>(xyz[2])].type == PlyType::Float32;
+        parallel_for(count, [&](std::size_t b, std::size_t end) {
+          if (packed_floats) {
+            std::memcpy(out.positions.data() + b, base + b * 12, (end - b) * 12);
+          } else {
+            for (std::size_t row = b; row < end; ++row) {
+              const char* r = base + row * row_bytes;
+              for (int a = 0; a < 3; ++a) {
+                const auto i = static_cast<std::size_t>(xyz[a]);
+                out.positions[row][a] = static_cast<float>(load_value(r + offset[i], e.properties[i].type, swap));
+              }
+            }
+          }
+          if (quality >= 0) {
+            const auto i = static_cast<std::size_t>(quality);
+            for (std::size_t row = b; row < end; ++row)
+              out.vertex_quality[row] =
+                  static_cast<float>(load_value(base + row * row_bytes + offset[i], e.properties[i].type, swap));
+          }
+          if (file) file->release(pos + b * row_bytes, pos + end * row_bytes);
+        }, 1 << 16);
+      }
+      pos += count * row_bytes;
+      continue;
+    }
+
+    // Rows with lists: sequential. The common face row (uchar 3, three 32-bit indices) is
+    // decoded without the general loop.
+    if (is_vertex) {
+      out.positions.resize(count);
+      if (quality >= 0) out.vertex_quality.resize(count);
+    }
+    if (is_face) {
+      out.triangles.reserve(std::min(count, (data.size() - pos) / 4 + 1));
+      if (quality >= 0) out.face_quality.reserve(out.triangles.capacity());
+    }
+    const std::size_t end_of_data = data.size();
+    const char* d = data.data();
+    const bool fast_face = is_face && e.properties.size() == 1 && e.properties[0].count_type == PlyType::UInt8 &&
+                           (e.properties[0].type == PlyType::Int32 || e.properties[0].type == PlyType::UInt32);
+    const auto vmax = static_cast<std::uint64_t>(vertex_count);
+    std::size_t released = pos;
+    for (std::size_t row = 0; row < count; ++row) {
+      if (fast_face && pos + 13 <= end_of_data && static_cast<unsigned char>(d[pos]) == 3) {
+        Triangle t;
+        bool ok = true;
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t v = load_raw<std::uint32_t>(d + pos + 1 + 4 * k, swap);
+          ok = ok && v < vmax;  // a negative int32 is >= 2^31 here
+          t[static_cast<std::size_t>(k)] = v;
+        }
+        if (!ok) {
+          for (int k = 0; k < 3; ++k) {
+            const std::int64_t v = load_index(d + pos + 1 + 4 * k, e.properties[0].type, swap);
+            if (v < 0 || v >= vertex_count)
+              fail(path, "face " + std::to_string(row) + " uses vertex " + std::to_string(v) +
+                             " but the file has " + std::to_string(vertex_count) + " vertices");
+          }
+        }
+        out.triangles.push_back(t);
+        pos += 13;
+      } else {
+        float row_quality = 0.0f;
+        for (std::size_t i = 0; i < e.properties.size(); ++i) {
+          const PlyProperty& p = e.properties[i];
+          if (!p.is_list) {
+            const std::size_t sz = type_size(p.type);
+            if (sz > end_of_data - pos) truncated();
+            if (static_cast<int>(i) == quality) row_quality = static_cast<float>(load_value(d + pos, p.type, swap));
+            for (int a = 0; a < 3; ++a)
+              if (is_vertex && static_cast<int>(i) == xyz[a])
+                out.positions[row][a] = static_cast<float>(load_value(d + pos, p.type, swap));
+            pos += sz;
+            continue;
+          }
+          const std::size_t csz = type_size(p.count_type);
+          if (csz > end_of_data - pos) truncated();
+          const double count_value = load_value(d + pos, p.count_type, swap);
+          pos += csz;
+          if (!(count_value >= 0.0) || count_value > static_cast<double>(end_of_data - h.data_start))
+            fail(path, what + " row " + std::to_string(row) + " has an impossible list length");
+          const auto n = static_cast<std::size_t>(count_value);
+          const std::size_t isz = type_size(p.type);
+          if (n * isz > end_of_data - pos) truncated();
+          if (static_cast<int>(i) == face_list) {
+            corners.resize(n);
+            for (std::size_t k = 0; k < n; ++k) {
+              const std::int64_t v = load_index(d + pos + k * isz, p.type, swap);
+              if (v < 0 || v >= vertex_count)
+                fail(path, "face " + std::to_string(row) + " uses vertex " + std::to_string(v) +
+                               " but the file has " + std::to_string(vertex_count) + " vertices");
+              corners[k] = static_cast<std::uint32_t>(v);
+            }
+            if (n < 3) ++skipped_faces;
+            append_fan(out.triangles, corners.data(), corners.size());
+          }
+          pos += n * isz;
+        }
+        if (is_face && quality >= 0) out.face_quality.resize(out.triangles.size(), row_quality);
+        if (is_vertex && quality >= 0) out.vertex_quality[row] = row_quality;
+        continue;
+      }
+      if (is_face && quality >= 0) out.face_quality.resize(out.triangles.size(), 0.0f);
+      if (file && pos - released > (std::size_t{1} << 24)) {
+        file->release(released, pos);
+        released = pos;
+      }
+    }
+  }
+  if (skipped_faces > 0)
+    out.warnings.push_back("skipped " + std::to_string(skipped_faces) + " faces with fewer than 3 vertices");
+}
+
 }  // namespace
 
-RawMesh read_ply(const std::string& path, std::string_view data) {
+RawMesh read_ply(const std::string& path, std::string_view data, const FileData* file) {
   const PlyHeader h = parse_header(path, data);
   const std::size_t data_bytes = data.size() - h.data_start;
 
@@ -330,10 +475,15 @@ RawMesh read_ply(const std::string& path, std::string_view data) {
     fail(path, "the header declares more elements than the file's " + std::to_string(data.size()) +
                    " bytes can hold (truncated file?)");
   if (vertex_count > static_cast<std::int64_t>(UINT32_MAX)) fail(path, "too many vertices");
-  for (const PlyElement& e : h.elements) {  // LoadOptions limits
+  std::int64_t face_count = 0;
+  for (const PlyElement& e : h.elements) {  // LoadOptions limits, then the memory this run needs
     if (e.name == "vertex") check_vertex_count(path, static_cast<std::uint64_t>(e.count));
-    if (e.name == "face") check_triangle_count(path, static_cast<std::uint64_t>(e.count), "faces");
+    if (e.name == "face") {
+      check_triangle_count(path, static_cast<std::uint64_t>(e.count), "faces");
+      face_count = e.count;
+    }
   }
+  check_mesh_fits(path, static_cast<std::uint64_t>(vertex_count), static_cast<std::uint64_t>(face_count));
 
   RawMesh out;
   if (h.encoding == PlyEncoding::Ascii) {
@@ -345,18 +495,7 @@ RawMesh read_ply(const std::string& path, std::string_view data) {
         },
         out);
   } else {
-    const bool big = h.encoding == PlyEncoding::BinaryBig;
-    const bool swap = big != (std::endian::native == std::endian::big);
-    BinaryCursor b(path, data, h.data_start, swap);
-    std::string current;
-    read_elements(
-        path, h, vertex_count, data_bytes,
-        [&](const std::string& what) {
-          current = what;
-          b.set_context(&current);
-          return BinarySource{b, current};
-        },
-        out);
+    read_binary(path, h, vertex_count, data, file, out);
   }
   return out;
 }

@@ -31,9 +31,41 @@ struct RawMesh {
 // Throws InputError unless `path` names an existing regular file.
 void check_regular_file(const std::string& path);
 
-// The whole file as bytes. Throws InputError for a missing file, a directory, an unreadable
-// file, or one larger than max_size bytes (0 = no limit), refused before it is read.
-std::string read_file(const std::string& path, std::uint64_t max_size = 0);
+// A file's bytes, memory-mapped read-only (no copy: pages come from the page cache as they are
+// read). release() hands a range already parsed back to the kernel, so a reader's resident
+// memory is its output, not the file. Move-only.
+class FileData {
+public:
+  FileData() = default;
+  FileData(FileData&& other) noexcept { *this = std::move(other); }
+  FileData& operator=(FileData&& other) noexcept;
+  FileData(const FileData&) = delete;
+  FileData& operator=(const FileData&) = delete;
+  ~FileData();
+
+  std::string_view view() const { return {data_, size_}; }
+  operator std::string_view() const { return view(); }  // NOLINT: a view of the bytes
+  // Drops the whole pages inside [begin, end) from this process's resident memory (they are
+  // read again from the page cache if touched later). A no-op for small files.
+  void release(std::size_t begin, std::size_t end) const;
+
+private:
+  friend FileData read_file(const std::string& path, std::uint64_t max_size);
+  const char* data_ = nullptr;
+  std::size_t size_ = 0;
+  bool mapped_ = false;
+};
+
+// The whole file. Throws InputError for a missing file, a directory, an unreadable file, or one
+// larger than max_size bytes (0 = no limit), refused before it is read.
+FileData read_file(const std::string& path, std::uint64_t max_size = 0);
+
+// Throws InputError "<path>: a mesh of V vertices and F triangles needs about X GiB to process,
+// more than the Y GiB of memory available" when the estimated memory of a whole run (input,
+// welded copy, BVH, device buffers, output; `bytes_per_vertex` / `bytes_per_triangle` measured
+// on a 13M-triangle run) exceeds the memory this process can get (MemAvailable, and the cgroup's
+// limit where one is set, and SDFKIT_MEMORY_LIMIT in bytes where set). Readers call it as soon as they know the counts, before allocating.
+void check_mesh_fits(const std::string& path, std::uint64_t vertices, std::uint64_t triangles);
 
 // Resource limits for the readers. load_asset sets them (ScopedReadLimits) for the reader it
 // calls on this thread; a reader calls the checks where a count is first known (a header's
@@ -64,15 +96,16 @@ void check_vertex_count(const std::string& path, std::uint64_t count);
 // indices are checked against the vertex count, coordinates are not (load_asset validates).
 RawMesh read_off(const std::string& path, std::string_view data);
 RawMesh read_obj(const std::string& path, std::string_view data);
-RawMesh read_ply(const std::string& path, std::string_view data);
+// `file` (optional): the mapping `data` comes from, whose parsed pages the reader releases.
+RawMesh read_ply(const std::string& path, std::string_view data, const FileData* file = nullptr);
 // glTF: `data` is the .gltf text or the .glb bytes; external files resolve as `options` says.
 RawMesh read_gltf(const std::string& path, std::string_view data, bool binary,
                   const LoadOptions& options);
 
 // load_asset after the file was read: the reader of `format`, the limits, validation and
-// welding (the fuzz harnesses' entry point).
+// welding (the fuzz harnesses' entry point). `file` (optional): the mapping `data` comes from.
 Asset load_from_memory(const std::string& path, Format format, std::string_view data,
-                       const LoadOptions& options);
+                       const LoadOptions& options, const FileData* file = nullptr);
 
 // Appends the fan triangulation (v0 v1 v2, v0 v2 v3, ...) of a polygon given by its corners.
 void append_fan(std::vector<Triangle>& triangles, const std::uint32_t* corners, std::size_t n);

@@ -1,6 +1,7 @@
 #include "sdfkit/opencl/bvh.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/parallel.hpp"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -8,7 +9,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <future>
+#include <atomic>
+#include <thread>
 #include <limits>
 #include <string>
 
@@ -41,7 +43,18 @@ struct Box {
   }
 };
 
-// Where a node's triangles go: a leaf, or two children split at `mid` (items partitioned).
+// One triangle being partitioned: its padded box and face index, 32 bytes, moved as a whole so
+// that every pass over a node's triangles reads memory in order.
+struct Ref {
+  glm::vec3 lo;
+  std::uint32_t face;
+  glm::vec3 hi;
+  std::uint32_t pad = 0;
+  glm::vec3 centroid() const { return (lo + hi) * 0.5f; }
+};
+static_assert(sizeof(Ref) == 32);
+
+// Where a node's triangles go: a leaf, or two children split at `mid` (refs partitioned).
 struct Split {
   Box bounds;
   bool leaf = true;
@@ -55,21 +68,71 @@ struct Subtree {
   std::size_t leaf_count = 0;
 };
 
+// Nodes with at least this many triangles bin on all threads (a pass over 1M refs is ~2 ms).
+constexpr std::size_t kParallelBinning = 1 << 18;
+
+struct Bins {
+  std::array<std::array<Box, kBins>, 3> box{};
+  std::array<std::array<std::size_t, kBins>, 3> count{};
+  Box bounds, cbounds;
+};
+
 struct Builder {
   BvhParams params;
-  std::vector<Box> boxes;           // per face
-  std::vector<glm::vec3> centroid;  // per face (of its box)
-  std::vector<std::uint32_t> items;  // face indices being partitioned
+  std::vector<Ref> refs;
 
-  // Bounds of items [begin, end) and the split the SAH (or the object median) chooses; a split
+  // Bounds and centroid bounds of refs [begin, end).
+  void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds) const {
+    const auto pass = [&](std::size_t b, std::size_t e, Box& bb, Box& cb) {
+      for (std::size_t i = b; i < e; ++i) {
+        bb.grow(Box{refs[i].lo, refs[i].hi});
+        cb.grow(refs[i].centroid());
+      }
+    };
+    if (end - begin < kParallelBinning) return pass(begin, end, bounds, cbounds);
+    std::vector<Box> bb(std::thread::hardware_concurrency() + 1), cb(bb.size());
+    std::atomic<std::size_t> slot{0};
+    parallel_for(end - begin, [&](std::size_t b, std::size_t e) {
+      const std::size_t k = slot++;
+      pass(begin + b, begin + e, bb[k], cb[k]);
+    }, kParallelBinning / 2);
+    for (std::size_t k = 0; k < bb.size(); ++k) bounds.grow(bb[k]), cbounds.grow(cb[k]);
+  }
+
+  // Bins refs [begin, end) by centroid on the three axes.
+  void bin(std::size_t begin, std::size_t end, int bins, const Box& cbounds, const glm::vec3& scale,
+           Bins& out) const {
+    const auto pass = [&](std::size_t b, std::size_t e, Bins& r) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Ref& ref = refs[i];
+        const glm::vec3 rel = (ref.centroid() - cbounds.lo) * scale;
+        const Box box{ref.lo, ref.hi};
+        for (int axis = 0; axis < 3; ++axis) {
+          const auto k = static_cast<std::size_t>(std::min(bins - 1, static_cast<int>(rel[axis])));
+          r.box[static_cast<std::size_t>(axis)][k].grow(box);
+          ++r.count[static_cast<std::size_t>(axis)][k];
+        }
+      }
+    };
+    if (end - begin < kParallelBinning) return pass(begin, end, out);
+    std::vector<Bins> partial(std::thread::hardware_concurrency() + 1);
+    std::atomic<std::size_t> slot{0};
+    parallel_for(end - begin, [&](std::size_t b, std::size_t e) { pass(begin + b, begin + e, partial[slot++]); },
+                 kParallelBinning / 2);
+    for (const Bins& p : partial)
+      for (std::size_t axis = 0; axis < 3; ++axis)
+        for (std::size_t k = 0; k < kBins; ++k) {
+          out.box[axis][k].grow(p.box[axis][k]);
+          out.count[axis][k] += p.count[axis][k];
+        }
+  }
+
+  // Bounds of refs [begin, end) and the split the SAH (or the object median) chooses; a split
   // partitions the range in place. Subtrees over disjoint ranges may be built concurrently.
   Split choose(std::size_t begin, std::size_t end, int depth) {
     Split s;
     Box cbounds;
-    for (std::size_t i = begin; i < end; ++i) {
-      s.bounds.grow(boxes[items[i]]);
-      cbounds.grow(centroid[items[i]]);
-    }
+    measure(begin, end, s.bounds, cbounds);
     const std::size_t n = end - begin;
     if (n <= 1) return s;
     std::size_t mid = begin;
@@ -77,29 +140,20 @@ struct Builder {
     const bool flat = !(extent.x > 0.0f || extent.y > 0.0f || extent.z > 0.0f);
     if (!flat && depth < kMedianBelowDepth) {
       // Binned SAH over the three axes, binned in one pass over the triangles.
-      std::array<std::array<Box, kBins>, 3> bin_box{};
-      std::array<std::array<std::size_t, kBins>, 3> bin_count{};
       // As many bins as triangles up to kBins: a small node's sweep over empty bins costs more
       // than its binning (most nodes are small).
       const int bins = static_cast<int>(std::min<std::size_t>(kBins, std::max<std::size_t>(n, 2)));
       glm::vec3 scale(0.0f);
       for (int axis = 0; axis < 3; ++axis)
         if (extent[axis] > 0.0f) scale[axis] = static_cast<float>(bins) / extent[axis];
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t f = items[i];
-        const glm::vec3 rel = (centroid[f] - cbounds.lo) * scale;
-        for (int axis = 0; axis < 3; ++axis) {
-          const auto b = static_cast<std::size_t>(std::min(bins - 1, static_cast<int>(rel[axis])));
-          bin_box[static_cast<std::size_t>(axis)][b].grow(boxes[f]);
-          ++bin_count[static_cast<std::size_t>(axis)][b];
-        }
-      }
+      Bins binned;
+      bin(begin, end, bins, cbounds, scale, binned);
       float best_cost = std::numeric_limits<float>::max();
       int best_axis = -1, best_split = 0;
       for (int axis = 0; axis < 3; ++axis) {
         if (!(extent[axis] > 0.0f)) continue;
-        const auto& bb = bin_box[static_cast<std::size_t>(axis)];
-        const auto& bc = bin_count[static_cast<std::size_t>(axis)];
+        const auto& bb = binned.box[static_cast<std::size_t>(axis)];
+        const auto& bc = binned.count[static_cast<std::size_t>(axis)];
         std::array<float, kBins> right_cost{};
         Box acc;
         std::size_t count = 0;
@@ -127,12 +181,11 @@ struct Builder {
       if (n <= static_cast<std::size_t>(params.leaf_size) && (best_axis < 0 || split_cost >= leaf_cost)) return s;
       if (best_axis >= 0) {
         const float sc = scale[best_axis], lo = cbounds.lo[best_axis];
-        const auto it = std::partition(items.begin() + static_cast<std::ptrdiff_t>(begin),
-                                       items.begin() + static_cast<std::ptrdiff_t>(end),
-                                       [&](std::uint32_t f) {
-                                         return std::min(bins - 1, static_cast<int>((centroid[f][best_axis] - lo) * sc)) <= best_split;
+        const auto it = std::partition(refs.begin() + static_cast<std::ptrdiff_t>(begin),
+                                       refs.begin() + static_cast<std::ptrdiff_t>(end), [&](const Ref& r) {
+                                         return std::min(bins - 1, static_cast<int>((r.centroid()[best_axis] - lo) * sc)) <= best_split;
                                        });
-        mid = static_cast<std::size_t>(it - items.begin());
+        mid = static_cast<std::size_t>(it - refs.begin());
       }
     } else if (n <= static_cast<std::size_t>(params.leaf_size)) {
       return s;
@@ -141,11 +194,11 @@ struct Builder {
       // Object median along the longest centroid axis (or by index when all coincide).
       const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
       mid = begin + n / 2;
-      std::nth_element(items.begin() + static_cast<std::ptrdiff_t>(begin),
-                       items.begin() + static_cast<std::ptrdiff_t>(mid),
-                       items.begin() + static_cast<std::ptrdiff_t>(end),
-                       [&](std::uint32_t a, std::uint32_t b) {
-                         return centroid[a][axis] != centroid[b][axis] ? centroid[a][axis] < centroid[b][axis] : a < b;
+      std::nth_element(refs.begin() + static_cast<std::ptrdiff_t>(begin),
+                       refs.begin() + static_cast<std::ptrdiff_t>(mid),
+                       refs.begin() + static_cast<std::ptrdiff_t>(end), [&](const Ref& a, const Ref& b) {
+                         const float ca = a.centroid()[axis], cb = b.centroid()[axis];
+                         return ca != cb ? ca < cb : a.face < b.face;
                        });
     }
     s.leaf = false;
@@ -153,7 +206,7 @@ struct Builder {
     return s;
   }
 
-  // Fills node `index` of `t` (already allocated) with items [begin, end), depth-first.
+  // Fills node `index` of `t` (already allocated) with refs [begin, end), depth-first.
   void build(Subtree& t, std::uint32_t index, std::size_t begin, std::size_t end, int depth) {
     t.depth = std::max(t.depth, depth);
     const Split s = choose(begin, end, depth);
@@ -179,42 +232,112 @@ struct Builder {
     ++t.leaf_count;
   }
 
-  // The whole tree. Large meshes: the root's two subtrees are built on two threads into their
-  // own arrays and spliced behind the root, which gives the sequential depth-first layout.
-  Bvh build_all() {
-    Bvh out;
-    const std::size_t n = items.size();
-    Subtree whole;
-    whole.nodes.emplace_back();
-    const Split s = n >= kParallelBelow ? choose(0, n, 0) : Split{};
-    if (n < kParallelBelow || s.leaf) {
-      build(whole, 0, 0, n, 0);
-    } else {
-      set_bounds(whole.nodes[0], s.bounds);
-      Subtree left, right;
-      left.nodes.emplace_back();
-      right.nodes.emplace_back();
-      auto done = std::async(std::launch::async, [&] { build(right, 0, s.mid, n, 1); });
-      build(left, 0, 0, s.mid, 1);
-      done.get();
-      const auto splice = [&](const Subtree& t) {
-        const auto offset = static_cast<std::uint32_t>(whole.nodes.size());
-        for (BvhNode node : t.nodes) {
-          if (!node.is_leaf()) node.first_or_second += offset;
-          whole.nodes.push_back(node);
-        }
-        whole.depth = std::max(whole.depth, t.depth);
-        whole.leaf_count += t.leaf_count;
-      };
-      whole.nodes.reserve(1 + left.nodes.size() + right.nodes.size());
-      splice(left);
-      whole.nodes[0].first_or_second = static_cast<std::uint32_t>(whole.nodes.size());
-      splice(right);
+  // The top of the tree, split on the calling thread (with parallel binning) until every part
+  // holds at most `task_size` triangles; the parts become subtree tasks.
+  struct Top {
+    Split split;
+    std::size_t begin = 0, end = 0;
+    int depth = 0;
+    int child[2] = {-1, -1};  // internal: Top indices
+    int task = -1;             // a part built as a task
+  };
+  int split_top(std::vector<Top>& top, std::vector<int>& tasks, std::size_t begin, std::size_t end, int depth,
+                std::size_t task_size) {
+    const int index = static_cast<int>(top.size());
+    top.push_back({});
+    top[static_cast<std::size_t>(index)].begin = begin;
+    top[static_cast<std::size_t>(index)].end = end;
+    top[static_cast<std::size_t>(index)].depth = depth;
+    if (end - begin <= task_size) {
+      top[static_cast<std::size_t>(index)].task = static_cast<int>(tasks.size());
+      tasks.push_back(index);
+      return index;
     }
-    out.nodes = std::move(whole.nodes);
-    out.depth = whole.depth;
-    out.leaf_count = whole.leaf_count;
-    out.order = std::move(items);
+    const Split s = choose(begin, end, depth);
+    top[static_cast<std::size_t>(index)].split = s;
+    if (s.leaf) return index;
+    const int l = split_top(top, tasks, begin, s.mid, depth + 1, task_size);
+    const int r = split_top(top, tasks, s.mid, end, depth + 1, task_size);
+    top[static_cast<std::size_t>(index)].child[0] = l;
+    top[static_cast<std::size_t>(index)].child[1] = r;
+    return index;
+  }
+
+  // The whole tree: the top split here, its parts built by all threads (each takes the next
+  // part), then laid out depth-first exactly as a sequential build would.
+  Bvh build_all() {
+    const std::size_t n = refs.size();
+    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    // Large meshes: parts of ~1/16 of the triangles per thread keep the threads busy to the
+    // end. Small ones: the root's two halves, as the top costs more than imbalance there.
+    const std::size_t task_size = n < kParallelBelow || threads == 1 ? n
+                                  : n < (std::size_t{1} << 20)        ? (n + 1) / 2
+                                                                      : n / (16 * threads);
+    std::vector<Top> top;
+    std::vector<int> tasks;
+    split_top(top, tasks, 0, n, 0, task_size);
+    std::vector<Subtree> parts(tasks.size());
+    // Largest parts first.
+    std::vector<std::size_t> schedule(tasks.size());
+    for (std::size_t k = 0; k < schedule.size(); ++k) schedule[k] = k;
+    std::sort(schedule.begin(), schedule.end(), [&](std::size_t a, std::size_t b) {
+      const Top& ta = top[static_cast<std::size_t>(tasks[a])];
+      const Top& tb = top[static_cast<std::size_t>(tasks[b])];
+      return ta.end - ta.begin > tb.end - tb.begin;
+    });
+    std::atomic<std::size_t> next{0};
+    const auto worker = [&] {
+      for (std::size_t k; (k = next++) < schedule.size();) {
+        const Top& t = top[static_cast<std::size_t>(tasks[schedule[k]])];
+        Subtree& part = parts[schedule[k]];
+        part.nodes.emplace_back();
+        build(part, 0, t.begin, t.end, t.depth);
+      }
+    };
+    {
+      std::vector<std::thread> pool;
+      const std::size_t helpers = std::min<std::size_t>(threads, tasks.size()) - 1;
+      for (std::size_t k = 0; k < helpers; ++k) pool.emplace_back(worker);
+      worker();
+      for (std::thread& th : pool) th.join();
+    }
+
+    Bvh out;
+    std::size_t total = top.size();
+    for (const Subtree& p : parts) total += p.nodes.size();
+    out.nodes.reserve(total);
+    const auto emit = [&](auto&& self, int index) -> void {
+      const Top& t = top[static_cast<std::size_t>(index)];
+      out.depth = std::max(out.depth, t.depth);
+      if (t.task >= 0) {
+        const Subtree& p = parts[static_cast<std::size_t>(t.task)];
+        const auto offset = static_cast<std::uint32_t>(out.nodes.size());
+        for (BvhNode node : p.nodes) {
+          if (!node.is_leaf()) node.first_or_second += offset;
+          out.nodes.push_back(node);
+        }
+        out.depth = std::max(out.depth, p.depth);
+        out.leaf_count += p.leaf_count;
+        return;
+      }
+      const std::size_t at = out.nodes.size();
+      out.nodes.emplace_back();
+      set_bounds(out.nodes[at], t.split.bounds);
+      if (t.split.leaf) {
+        out.nodes[at].first_or_second = static_cast<std::uint32_t>(t.begin);
+        out.nodes[at].count = BvhNode::kLeafBit | static_cast<std::uint32_t>(t.end - t.begin);
+        ++out.leaf_count;
+        return;
+      }
+      self(self, t.child[0]);
+      out.nodes[at].first_or_second = static_cast<std::uint32_t>(out.nodes.size());
+      self(self, t.child[1]);
+    };
+    emit(emit, 0);
+    out.order.resize(n);
+    parallel_for(n, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) out.order[i] = refs[i].face;
+    }, 1 << 16);
     return out;
   }
 };
@@ -235,21 +358,35 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     throw InputError("the BVH leaf size must be at least 1, got " + std::to_string(params.leaf_size));
   if (!(params.traversal_cost > 0.0f) || !std::isfinite(params.traversal_cost))
     throw InputError("the BVH traversal cost must be positive, got " + std::to_string(params.traversal_cost));
-  Builder b{params, {}, {}, {}};
+  Builder b{params, {}};
   const auto degenerate = degenerate_faces(mesh);
-  b.boxes.resize(mesh.triangles.size());
-  b.centroid.resize(mesh.triangles.size());
-  for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f) {
-    if (degenerate[f]) continue;
-    for (std::uint32_t v : mesh.triangles[f]) b.boxes[f].grow(mesh.positions[v]);
-    b.centroid[f] = (b.boxes[f].lo + b.boxes[f].hi) * 0.5f;
-    b.items.push_back(f);
+  std::size_t kept = 0;
+  for (std::uint8_t d : degenerate) kept += d == 0;
+  b.refs.resize(kept);
+  // Unpadded boxes, in face order, and the padding (as before: of the boxes' corners).
+  std::vector<std::size_t> slot_of(mesh.triangles.size() + 1, 0);
+  for (std::size_t f = 0, k = 0; f < mesh.triangles.size(); ++f) {
+    slot_of[f] = k;
+    k += degenerate[f] == 0;
   }
-  const glm::vec3 pad = box_padding(b.boxes, b.items);
-  for (std::uint32_t f : b.items) {
-    b.boxes[f].lo -= pad;
-    b.boxes[f].hi += pad;
-  }
+  std::vector<float> largest(std::thread::hardware_concurrency() + 1, 0.0f);
+  std::atomic<std::size_t> slot{0};
+  parallel_for(mesh.triangles.size(), [&](std::size_t begin, std::size_t end) {
+    float big = 0.0f;
+    for (std::size_t f = begin; f < end; ++f) {
+      if (degenerate[f]) continue;
+      Box box;
+      for (std::uint32_t v : mesh.triangles[f]) box.grow(mesh.positions[v]);
+      b.refs[slot_of[f]] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi};
+      big = std::max({big, glm::length(box.lo), glm::length(box.hi)});
+    }
+    largest[slot++] = big;
+  }, 1 << 16);
+  slot_of = {};
+  const glm::vec3 pad(1e-6f * *std::max_element(largest.begin(), largest.end()) + std::numeric_limits<float>::min());
+  parallel_for(b.refs.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) b.refs[i].lo -= pad, b.refs[i].hi += pad;
+  }, 1 << 16);
   return b.build_all();
 }
 

@@ -3,6 +3,7 @@
 #include "cl_api.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/parallel.hpp"
 #include "sdfkit/core/mesh.hpp"
 #include "sdfkit/core/sdf_definition.hpp"
 
@@ -298,17 +299,6 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
     octree = build_octree(mesh, OctreeParams{config.octree_max_depth, config.octree_leaf_size});
     order = &octree.refs;
   }
-  // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w.
-  const std::vector<glm::vec3> normals_f = face_normals(mesh);
-  std::vector<glm::vec4> records(3 * order->size());
-  for (std::size_t k = 0; k < order->size(); ++k) {
-    const std::uint32_t f = (*order)[k];
-    const auto& t = mesh.triangles[f];
-    const glm::vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
-    records[3 * k] = glm::vec4(a, normals_f[f].x);
-    records[3 * k + 1] = glm::vec4(b - a, normals_f[f].y);
-    records[3 * k + 2] = glm::vec4(c - a, normals_f[f].z);
-  }
   octree_ms = ms_since(start);
 
   start = std::chrono::steady_clock::now();
@@ -325,8 +315,30 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
     write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
     write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
   }
-  tris.reserve(ctx, bytes_of(records), CL_MEM_READ_ONLY, "triangles");
-  write(tris.get(), bytes_of(records), records.data(), "triangles");
+  // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w; written
+  // straight into the mapped device buffer (no host copy of 48 bytes per triangle beside it).
+  const std::vector<glm::vec3> normals_f = face_normals(mesh);
+  const std::size_t record_bytes = 3 * order->size() * sizeof(glm::vec4);
+  tris.reserve(ctx, std::max<std::size_t>(record_bytes, 16), CL_MEM_READ_ONLY, "triangles");
+  if (record_bytes > 0) {
+    cl_int err = CL_SUCCESS;
+    void* mapped = clEnqueueMapBuffer(queue.get(), tris.get(), CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0,
+                                      record_bytes, 0, nullptr, nullptr, &err);
+    check(err, "mapping the triangle buffer");
+    auto* records = static_cast<glm::vec4*>(mapped);
+    parallel_for(order->size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::uint32_t f = (*order)[k];
+        const auto& t = mesh.triangles[f];
+        const glm::vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+        records[3 * k] = glm::vec4(a, normals_f[f].x);
+        records[3 * k + 1] = glm::vec4(b - a, normals_f[f].y);
+        records[3 * k + 2] = glm::vec4(c - a, normals_f[f].z);
+      }
+    }, 1 << 16);
+    check(clEnqueueUnmapMemObject(queue.get(), tris.get(), mapped, 0, nullptr, nullptr),
+          "unmapping the triangle buffer");
+  }
   finish("uploading the mesh");
   upload_ms = ms_since(start);
   geometry_bytes = nodes.size() + cells.size() + tris.size();

@@ -46,7 +46,8 @@ io::Asset load_input(const std::string& path, const io::LoadOptions& options) {
   asset.format = io::Format::Off;
   asset.input_positions = mesh.positions;
   asset.input_triangles = mesh.triangles;
-  WeldResult welded = weld(mesh.positions, mesh.triangles, options.weld_tolerance);
+  asset.weld_tolerance = io::weld_tolerance_for(options, mesh.positions);
+  WeldResult welded = weld(mesh.positions, mesh.triangles, asset.weld_tolerance);
   asset.mesh = std::move(welded.mesh);
   asset.input_to_welded = std::move(welded.input_to_welded);
   return asset;
@@ -92,6 +93,12 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
   out.asset = preloaded ? std::move(*preloaded) : load_input(request.input, request.load);
   const io::Asset& asset = out.asset;
   report.stages.push_back({"load", clock.lap_ms()});
+  for (StageTiming s : asset.load_stages) {
+    s.nested = true;
+    report.stages.push_back(s);
+  }
+  const auto sample = [&](const char* stage) { report.memory.push_back({stage, resident_memory()}); };
+  sample("weld");
   report.input_vertices = asset.input_positions.size();
   report.input_faces = asset.input_triangles.size();
   report.welded_vertices = asset.mesh.positions.size();
@@ -102,11 +109,14 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
   report.device = session.backend().device_name();
   report.backend_choice = session.choice().reason;
   report.stages.push_back({"device", clock.lap_ms()});
+  sample("device");
   session.set_mesh(asset.mesh);
   const double set_mesh_ms = clock.lap_ms();
+  sample("set_mesh");
   out.field = session.compute(request.sdf);
   SdfField& field = out.field;
   const double compute_ms = clock.lap_ms();
+  sample("sdf");
   const auto backend_stages = session.backend().last_timings();
   if (backend_stages.empty()) {
     report.stages.push_back({"prepare", set_mesh_ms});
@@ -126,6 +136,7 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
     smooth.rings = request.smooth_rings;
     field.values = smooth_field(asset.mesh, field.domain, field.values, smooth);
     report.stages.push_back({"smooth", clock.lap_ms()});
+    sample("smooth");
   }
   report.summary = summarize(field.values);
   return out;
@@ -148,6 +159,7 @@ ComputeReport run_compute(const ComputeRequest& request, const SessionProvider& 
     clock.lap_ms();
     io::write_field(request.output, r.asset, r.field, request.write);
     r.report.stages.push_back({"write", clock.lap_ms()});
+    r.report.memory.push_back({"write", resident_memory()});
   }
   return std::move(r.report);
 }

@@ -2,11 +2,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 namespace sdfkit {
 
 std::string report_to_json(const ComputeReport& r, const std::string& error, const std::string& fingerprint) {
   nlohmann::json stages = nlohmann::json::object();
   for (const StageTiming& s : r.stages) stages[s.stage] = s.milliseconds;
+  nlohmann::json memory = nlohmann::json::object();
+  double peak = 0;
+  for (const StageMemory& m : r.memory) {
+    memory[m.stage] = {{"rss", m.memory.rss_mib}, {"peak_rss", m.memory.peak_rss_mib}};
+    peak = std::max(peak, m.memory.peak_rss_mib);
+  }
   nlohmann::json j = {
       {"input", r.input},
       {"output", r.output},
@@ -21,6 +29,8 @@ std::string report_to_json(const ComputeReport& r, const std::string& error, con
       {"options", r.options.empty() ? nlohmann::json(nullptr) : nlohmann::json::parse(r.options)},
       {"time_ms", stages},
       {"total_ms", total_milliseconds(r.stages)},
+      {"memory_mib", memory},
+      {"peak_rss_mib", peak},
       {"summary",
        {{"min", r.summary.min}, {"median", r.summary.median}, {"mean", r.summary.mean}, {"max", r.summary.max}}},
       {"warnings", r.warnings},

@@ -151,20 +151,22 @@ values: (V,) per welded vertex (per="vertex") or (F,) per face (per="face"), mod
 
   m.def(
       "load",
-      [](const std::string& path, float weld_tolerance, bool allow_external_paths,
+      [](const std::string& path, std::optional<float> weld_tolerance, bool allow_external_paths,
          std::uint64_t max_triangles, std::uint64_t max_file_size) {
-        if (!(weld_tolerance >= 0.0f))
-          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
-        const io::LoadOptions options{weld_tolerance, allow_external_paths, max_triangles, max_file_size};
+        if (weld_tolerance && !(*weld_tolerance >= 0.0f))
+          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(*weld_tolerance));
+        const io::LoadOptions options{weld_tolerance.value_or(io::LoadOptions::kDefaultWeld), allow_external_paths,
+                                      max_triangles, max_file_size};
         py::gil_scoped_release unlocked;
         return std::make_shared<io::Asset>(load_input(path, options));
       },
-      "path"_a, "weld_tolerance"_a = 0.0f, py::kw_only(), "allow_external_paths"_a = false,
+      "path"_a, "weld_tolerance"_a = py::none(), py::kw_only(), "allow_external_paths"_a = false,
       "max_triangles"_a = io::kDefaultMaxTriangles, "max_file_size"_a = io::kDefaultMaxFileSize,
       R"doc(Loads a mesh file (.gltf .glb .obj .off .ply) or a built-in shape ("builtin:sphere",
 "builtin:torus", "builtin:capsule", "builtin:slab", "builtin:tube") and returns an sdfkit.Asset.
 
-Positions closer than weld_tolerance (model units; 0 = bitwise-equal only) are welded into one
+Positions closer than weld_tolerance (model units; 0 = bitwise-equal only; None = 1e-6 of the
+bounding box, which merges seam duplicates that differ by float rounding) are welded into one
 vertex. Raises sdfkit.InputError "<path>: <problem>" for a missing or malformed file.
 
 Assets are untrusted (SECURITY.md): a glTF's external buffers and images are read only from
@@ -269,7 +271,7 @@ void bind_functions(py::module_& m) {
       [](const std::string& input, const std::optional<std::string>& output, Session* session,
          const std::string& backend, const std::string& device, int views, int resolution, std::size_t memory_cap,
          const std::string& per, int rays, float cone, const std::string& false_hits, int smooth, bool normalize,
-         bool color, float weld_tolerance, bool allow_external_paths, std::uint64_t max_triangles,
+         bool color, std::optional<float> weld_tolerance, bool allow_external_paths, std::uint64_t max_triangles,
          std::uint64_t max_file_size) {
         ComputeRequest request;
         request.input = input;
@@ -279,9 +281,9 @@ void bind_functions(py::module_& m) {
         request.smooth_rings = smooth;
         request.write.color = color;
         request.write.normalized = normalize;
-        if (!(weld_tolerance >= 0.0f))
-          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(weld_tolerance));
-        request.load.weld_tolerance = weld_tolerance;
+        if (weld_tolerance && !(*weld_tolerance >= 0.0f))
+          throw InputError("weld_tolerance must be >= 0, got " + std::to_string(*weld_tolerance));
+        request.load.weld_tolerance = weld_tolerance.value_or(io::LoadOptions::kDefaultWeld);
         request.load.allow_external_paths = allow_external_paths;
         request.load.max_triangles = max_triangles;
         request.load.max_file_size = max_file_size;
@@ -303,7 +305,7 @@ void bind_functions(py::module_& m) {
       "input"_a, "output"_a = py::none(), py::kw_only(), "session"_a = nullptr, "backend"_a = "auto",
       "device"_a = "", "views"_a = 0, "resolution"_a = 0, "memory_cap"_a = 0, "per"_a = "vertex",
       "rays"_a = kDefaultRays, "cone"_a = kDefaultConeDegrees, "false_hits"_a = "paper", "smooth"_a = 0,
-      "normalize"_a = false, "color"_a = true, "weld_tolerance"_a = 0.0f,
+      "normalize"_a = false, "color"_a = true, "weld_tolerance"_a = py::none(),
       "allow_external_paths"_a = false, "max_triangles"_a = io::kDefaultMaxTriangles,
       "max_file_size"_a = io::kDefaultMaxFileSize,
       R"doc(What `sdfkit compute INPUT -o OUTPUT` does: load, compute, optionally smooth, write

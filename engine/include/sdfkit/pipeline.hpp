@@ -44,13 +44,29 @@ struct FieldSummary {
 };
 FieldSummary summarize(std::span<const float> values);
 
+// This process's resident memory (Linux /proc/self/status: VmRSS, and its peak so far VmHWM),
+// MiB; zeros where the system does not say.
+struct ResidentMemory {
+  double rss_mib = 0, peak_rss_mib = 0;
+};
+ResidentMemory resident_memory();
+
+// The resident memory after one step of a run.
+struct StageMemory {
+  std::string stage;
+  ResidentMemory memory;
+};
+
 struct ComputeReport {
   std::string input, output;
   std::size_t input_vertices = 0, input_faces = 0, welded_vertices = 0, points = 0;
   std::string backend, device;
   std::string backend_choice;       // why this backend (BackendChoice::reason)
   std::string options;              // options_to_json of the request
-  std::vector<StageTiming> stages;  // load, each backend stage, smooth, write
+  std::vector<StageTiming> stages;  // load (nested: read, weld), each backend stage, smooth, write
+  // After each step: read, weld, device, set_mesh (BVH or octree build, upload), sdf (trace),
+  // smooth, write. The peak is the process's so far, so a step's own peak shows where it grows.
+  std::vector<StageMemory> memory;
   std::size_t filled_points = 0;    // points with no accepted ray, filled from neighbours
   FieldSummary summary;
   std::vector<std::string> warnings;

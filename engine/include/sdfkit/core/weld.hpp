@@ -14,10 +14,26 @@ struct WeldResult {
   std::vector<std::uint32_t> input_to_welded;  // one entry per input vertex
 };
 
-// Welds positions equal within `tolerance` (model units; 0 = bitwise-equal coordinates, the
-// default). With a tolerance, a vertex joins an earlier welded vertex within that
-// distance (greedy in input order, so the result is deterministic). Triangle count and order are
-// preserved; a triangle whose corners weld together becomes degenerate, not removed.
+// The tolerance that welding uses by default: one millionth of the larger of the positions'
+// bounding-box diagonal and their largest coordinate magnitude (model units). Seam duplicates
+// that were computed twice (a UV sphere's seam and poles, cos(2 pi) next to cos(0)) differ by a
+// few float roundings, i.e. a few 1e-7 of the coordinates' magnitude: this merges them with a
+// margin, and stays far below any real edge (a 13M-triangle mesh's edges are ~3e-4 of its
+// diagonal). 0 for empty or non-finite input.
+float default_weld_tolerance(std::span<const glm::vec3> positions);
+
+// Welds positions within `tolerance` of each other (model units; 0 = bitwise-equal coordinates,
+// -0 and +0 alike). A vertex joins the earliest earlier welded vertex within that distance
+// (greedy in input order, so the result is deterministic and independent of the thread count);
+// welded vertices keep the position of their first input vertex and are numbered in input
+// order. Triangle count and order are preserved; a triangle whose corners weld together becomes
+// degenerate, not removed. Indices out of range are copied as they are.
+//
+// Found by hashing a grid of cells 16 x the tolerance (a match lies in the cells that the box of
+// +-tolerance around a point overlaps: 1 to 8 of them, ~1.2 on average): the table is filled in
+// one pass, looked up in parallel over the hardware threads, and only vertices that have an
+// earlier neighbour within the tolerance are then resolved in input order. Chains are kept in
+// index order, so many copies of one point cost linear time. Memory: ~4 x 2 + 12 bytes per input vertex beside the result.
 WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> triangles,
                 float tolerance = 0.0f);
 

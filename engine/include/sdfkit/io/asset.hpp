@@ -36,9 +36,14 @@ inline constexpr std::uint64_t kDefaultMaxTriangles = 50'000'000;
 inline constexpr std::uint64_t kDefaultMaxFileSize = std::uint64_t{2} << 30;  // 2 GiB
 
 struct LoadOptions {
+  // weld_tolerance's default: sdfkit::default_weld_tolerance of the input positions (1e-6 of the
+  // larger of their bounding-box diagonal and largest coordinate), which merges seam duplicates
+  // that differ by float rounding.
+  static constexpr float kDefaultWeld = -1.0f;
   // Positions closer than this (model units, after glTF node transforms) become one welded
-  // vertex; 0 welds bitwise-equal positions only. See sdfkit::weld.
-  float weld_tolerance = 0.0f;
+  // vertex; 0 welds bitwise-equal positions only; negative (kDefaultWeld) = the default above.
+  // See sdfkit::weld.
+  float weld_tolerance = kDefaultWeld;
   // Asset contents are untrusted (SECURITY.md). By default a glTF's external buffers and images
   // are read only from inside the asset's own directory (after resolving `..` and symbolic
   // links); absolute paths, parent escapes, URI schemes other than data: and links leading
@@ -53,8 +58,12 @@ struct LoadOptions {
   std::uint64_t max_file_size = kDefaultMaxFileSize;
 };
 
-// Throws InputError unless the options are usable (weld tolerance finite and >= 0).
+// Throws InputError unless the options are usable (weld tolerance finite; limits as documented).
 void validate_load_options(const LoadOptions& options);
+
+// The tolerance `options` asks for on these positions (model units): weld_tolerance itself, or
+// the default when it is negative.
+float weld_tolerance_for(const LoadOptions& options, std::span<const glm::vec3> positions);
 
 struct Asset {
   std::string path;
@@ -70,6 +79,10 @@ struct Asset {
   Mesh mesh;
   // For each input vertex, its welded vertex in `mesh`.
   std::vector<std::uint32_t> input_to_welded;
+  // The welding tolerance used (model units; 0 = bitwise-equal positions).
+  float weld_tolerance = 0.0f;
+  // How long loading took: "read" (parse and validate the file), "weld".
+  std::vector<StageTiming> load_stages;
   // Things skipped or changed while loading ("skipped 2 LINES primitives"), also logged.
   std::vector<std::string> warnings;
   // Format-specific data the writers need to write the input back (for glTF: the parsed model
