@@ -70,7 +70,9 @@ void validate(const ComputeRequest& r) {
   validate_options(r.sdf);
   if (r.smooth_rings < 0 || r.smooth_rings > 64)
     throw UsageError("--smooth must be between 0 and 64 rings, got " + std::to_string(r.smooth_rings));
-  if (!(r.load.weld_tolerance >= 0.0f) || !std::isfinite(r.load.weld_tolerance))
+  // io::LoadOptions::kDefaultWeld stands for the default tolerance (1e-6 of the bounding box).
+  if (r.load.weld_tolerance != io::LoadOptions::kDefaultWeld &&
+      (!(r.load.weld_tolerance >= 0.0f) || !std::isfinite(r.load.weld_tolerance)))
     throw UsageError("--weld-tolerance must be a finite number >= 0");
   check_backend_options(r.backend.kind, r.backend, r.sdf);
 }

@@ -102,7 +102,7 @@ TEST(BackendContract, BadValuesAreUsageErrors) {
   r.smooth_rings = -1;
   EXPECT_THROW(validate(r), UsageError);
   r = {};
-  r.load.weld_tolerance = -1.0f;
+  r.load.weld_tolerance = -0.5f;  // negative, and not io::LoadOptions::kDefaultWeld (the default)
   EXPECT_THROW(validate(r), UsageError);
   EXPECT_THROW(parse_shard("2/2"), UsageError);
 }
