@@ -64,15 +64,15 @@ void add_compress_animation_command(CLI::App& app) {
   cmd->get_option("--backend")->description("auto | vulkan | opencl (auto: OpenCL first)");
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
-    if (a->sdf.sdf.domain != SdfDomain::Vertex) throw InputError("point clouds use the per-point SDF (--per vertex)");
+    if (a->sdf.sdf.domain != SdfDomain::Vertex) throw UsageError("point clouds use the per-point SDF (--per vertex)");
     const std::string ext = std::filesystem::path(a->output).extension().string();
-    if (ext != ".glb" && ext != ".GLB") throw InputError(a->output + ": the output must be a .glb file");
+    if (ext != ".glb" && ext != ".GLB") throw UsageError(a->output + ": the output must be a .glb file");
     if (!a->json.empty() && std::filesystem::path(a->json).extension() != ".json")
-      throw InputError(a->json + ": the report must be a .json file");
+      throw UsageError(a->json + ": the report must be a .json file");
     const pointcloud::FrameSet all = pointcloud::read_frames(a->input, false);
     const bool sibernetic = std::filesystem::exists(std::filesystem::path(a->input) / "positions_f32le.bin");
     double frame_time = a->frame_time > 0.0 ? a->frame_time : all.frame_time;
-    if (!(frame_time > 0.0)) throw InputError("--frame-time is required: " + a->input + " does not say the time between frames");
+    if (!(frame_time > 0.0)) throw UsageError("--frame-time is required: " + a->input + " does not say the time between frames");
     if (all.frames.size() < 2) throw InputError(a->input + ": an animation needs at least 2 frames");
     for (std::size_t f = 1; f < all.frames.size(); ++f)
       if (all.frames[f].size() != all.frames[0].size())

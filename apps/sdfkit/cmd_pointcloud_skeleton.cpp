@@ -74,9 +74,9 @@ void add_pointcloud_skeleton_command(CLI::App& app) {
   cmd->get_option("--backend")->description("auto | vulkan | opencl (auto: OpenCL first)");
   cmd->callback([a] {
     finish_sdf_options(a->sdf);
-    if (a->sdf.sdf.domain != SdfDomain::Vertex) throw InputError("point clouds use the per-point SDF (--per vertex)");
+    if (a->sdf.sdf.domain != SdfDomain::Vertex) throw UsageError("point clouds use the per-point SDF (--per vertex)");
     const std::string ext = std::filesystem::path(a->output).extension().string();
-    if (ext != ".json" && ext != ".JSON") throw InputError(a->output + ": the output must be a .json file");
+    if (ext != ".json" && ext != ".JSON") throw UsageError(a->output + ": the output must be a .json file");
     pointcloud::SkeletonOptions options = a->options;
     options.segments = a->segments;
     options.threshold = a->threshold;

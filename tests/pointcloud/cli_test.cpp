@@ -99,7 +99,9 @@ TEST(PointcloudCli, BadInputIsOneErrorLineAndNoOutput) {
   EXPECT_EQ(run("pointcloud-skeleton " + (d.dir() / "few.xyz").string() + " -o " + out.string() + " --segments 4 --threshold 2",
                 d.dir() / "log"),
             2);
-  EXPECT_EQ(run("pointcloud-skeleton " + (d.dir() / "few.xyz").string() + " -o " + (d.dir() / "o.txt").string(), d.dir() / "log"), 1);
+  // Usage errors exit 2: the output's extension, the per-face SDF.
+  EXPECT_EQ(run("pointcloud-skeleton " + (d.dir() / "few.xyz").string() + " -o " + (d.dir() / "o.txt").string(), d.dir() / "log"), 2);
+  EXPECT_EQ(run("pointcloud-skeleton " + (d.dir() / "few.xyz").string() + " -o " + out.string() + " --per face", d.dir() / "log"), 2);
   // compress-animation: frames of different sizes; no frame time for plain files.
   fs::create_directories(d.dir() / "frames");
   std::ofstream(d.dir() / "frames" / "a.xyz") << "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
@@ -107,7 +109,9 @@ TEST(PointcloudCli, BadInputIsOneErrorLineAndNoOutput) {
   const fs::path glb = d.dir() / "o.glb";
   EXPECT_EQ(run("compress-animation " + (d.dir() / "frames").string() + " -o " + glb.string() + " --frame-time 0.1", d.dir() / "log"), 1);
   EXPECT_NE(slurp(d.dir() / "log").find("same points"), std::string::npos) << slurp(d.dir() / "log");
-  EXPECT_EQ(run("compress-animation " + (d.dir() / "frames").string() + " -o " + glb.string(), d.dir() / "log"), 1);
+  EXPECT_EQ(run("compress-animation " + (d.dir() / "frames").string() + " -o " + glb.string(), d.dir() / "log"), 2);
+  EXPECT_EQ(run("compress-animation " + kWorm + " -o " + (d.dir() / "o.gltf").string(), d.dir() / "log"), 2);
+  EXPECT_EQ(run("compress-animation " + kWorm + " -o " + glb.string() + " --json " + (d.dir() / "r.txt").string(), d.dir() / "log"), 2);
   EXPECT_EQ(run("compress-animation " + kWorm + " -o " + glb.string() + " --bones 3", d.dir() / "log"), 2);
   EXPECT_FALSE(fs::exists(glb));
 }
