@@ -348,7 +348,7 @@ void read_binary(const std::string& path, const PlyHeader& h, std::int64_t verte
                                    e.properties[static_cast<std::size_t>(xyz[2])].type == PlyType::Float32;
         parallel_for(count, [&](std::size_t b, std::size_t end) {
           if (packed_floats) {
-            std::memcpy(out.positions.data() + b, base + b * 12, (end - b) * 12);
+            if (end > b) std::memcpy(out.positions.data() + b, base + b * 12, (end - b) * 12);  // not with a null destination (0 vertices)
           } else {
             for (std::size_t row = b; row < end; ++row) {
               const char* r = base + row * row_bytes;
