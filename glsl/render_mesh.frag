@@ -22,5 +22,6 @@ void main() {
   const vec3 c = mix(palette[i].rgb, palette[min(i + 1, last)].rgb, clamp(x - float(i), 0.0, 1.0));
   const float len = length(in_normal);
   const float lambert = len > 0.0 ? abs(dot(in_normal / len, pc.eye.xyz)) : 1.0;
-  out_color = vec4(c * (0.3 + 0.7 * lambert), 1.0);
+  // scale.w fades the shaded colour towards white (skeleton pictures).
+  out_color = vec4(mix(c * (0.3 + 0.7 * lambert), vec3(1.0), clamp(pc.scale.w, 0.0, 1.0)), 1.0);
 }

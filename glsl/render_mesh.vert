@@ -8,7 +8,7 @@ layout(location = 2) in float in_value;
 layout(push_constant) uniform Push {
   mat4 view_projection;
   vec4 eye;    // xyz: unit direction towards the viewer (the headlight)
-  vec4 scale;  // x: value at the palette's start, y: at its end, z: palette entries
+  vec4 scale;  // x: value at the palette's start, y: at its end, z: palette entries, w: fade to white
 } pc;
 
 layout(location = 0) out vec3 out_normal;

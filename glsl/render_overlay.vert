@@ -4,7 +4,7 @@
 struct Segment {
   vec4 a;      // xyz: first end (model units), w: half width in pixels
   vec4 b;      // xyz: second end
-  vec4 color;  // rgb
+  vec4 color;  // rgb; w: layer, 0 drawn over 1 over 2 over 3 (depth orders within a layer)
 };
 layout(std430, set = 0, binding = 0) readonly buffer Segments { Segment segments[]; };
 
@@ -31,5 +31,8 @@ void main() {
   const vec4 c = k.x < 0.0 ? ca : cb;
   const vec2 offset_px = (dir * k.x + perp * k.y) * s.a.w;
   gl_Position = c + vec4(2.0 * offset_px / pc.viewport.xy * c.w, 0.0, 0.0);
+  // Layers: depth in [0, 1] squeezed into [layer / 4, (layer + 1) / 4].
+  const float z = clamp(gl_Position.z / gl_Position.w, 0.0, 1.0);
+  gl_Position.z = 0.25 * (z + clamp(s.color.w, 0.0, 3.0)) * gl_Position.w;
   out_color = s.color.rgb;
 }

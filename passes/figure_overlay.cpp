@@ -1,5 +1,6 @@
-// Figure overlay pass: the skeleton's segments and points drawn over the mesh in each view
-// (glsl/render_overlay.*), depth cleared so they stay on top.
+// Figure overlay pass: segments and square points (a skeleton's edges and nodes, a point cloud's
+// sprites) drawn over what is in the colour image in each view (glsl/render_overlay.*), depth
+// cleared so they stay on top; the colour is cleared first when nothing was drawn before.
 #include "figure_passes.hpp"
 
 namespace sdfkit::render::passes {
@@ -8,7 +9,10 @@ FigureOutput add_figure_overlay_pass(vk::RenderGraph& graph, const FigureOverlay
   constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   auto overlay = graph.add_pass("figure.skeleton", vk::PassKind::Graphics);
   FigureOutput out;
-  out.color = overlay.color(in.color, vk::LoadOp::Load);
+  out.color = in.clear_color ? overlay.color(in.color, vk::LoadOp::Clear,
+                                            VkClearColorValue{{in.clear_color->x, in.clear_color->y,
+                                                               in.clear_color->z, 1.0f}})
+                             : overlay.color(in.color, vk::LoadOp::Load);
   out.depth = overlay.depth(in.depth, vk::LoadOp::Clear, 1.0f);  // on top of the mesh
   overlay.storage_read(in.segments);
   overlay.execute([in](vk::PassContext& pc) {

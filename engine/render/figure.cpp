@@ -149,11 +149,21 @@ Image render_figure(vk::Context& ctx, const Mesh& welded, std::span<const float>
 
   const Layout l = plan(options);
   if (l.panel_h < 32) throw InputError("the figure is too small for its histogram and colour bar");
-  const std::vector<SceneView> views = orbit_views(welded, options.views, options.width, l.panel_h);
+  std::vector<glm::vec3> framed = welded.positions;
+  framed.insert(framed.end(), options.points.begin(), options.points.end());
+  framed.insert(framed.end(), options.skeleton.nodes.begin(), options.skeleton.nodes.end());
+  const std::vector<SceneView> views = orbit_views(framed, options.views, options.width, l.panel_h, options.setup);
 
   MeshRenderer renderer(ctx);
   renderer.set_mesh(welded, values, domain, scale);
-  renderer.set_overlay(options.lines, options.points);
+  renderer.set_fade(options.fade);
+  if (!options.skeleton.empty()) {
+    if (!options.lines.empty() || !options.points.empty())
+      throw InputError("a figure takes either a skeleton or plain lines and points, not both");
+    renderer.set_skeleton(options.skeleton);
+  } else {
+    renderer.set_overlay(options.lines, options.points);
+  }
   const Image panel = renderer.render(static_cast<std::uint32_t>(options.width),
                                       static_cast<std::uint32_t>(l.panel_h), views);
 
@@ -164,6 +174,8 @@ Image render_figure(vk::Context& ctx, const Mesh& welded, std::span<const float>
   std::copy(panel.rgba.begin(), panel.rgba.end(), fig.rgba.begin());
 
   const int x0 = l.margin, x1 = options.width - l.margin;  // histogram and bar share this axis
+  const float fade = std::clamp(options.fade, 0.0f, 1.0f);  // as the mesh's colours
+  const auto shown = [&](float v) { return to_bytes(scale.color(v) * (1.0f - fade) + glm::vec3(fade)); };
   const std::array<std::uint8_t, 3> ink{40, 40, 40}, axis{150, 150, 150};
   if (options.histogram) {
     const int bins = std::clamp((x1 - x0) / 8, 8, 64);
@@ -179,14 +191,14 @@ Image render_figure(vk::Context& ctx, const Mesh& welded, std::span<const float>
       const int h = static_cast<int>(std::lround(static_cast<double>(counts[static_cast<std::size_t>(b)]) /
                                                  static_cast<double>(top) * l.hist_h));
       const float centre = lo + (hi - lo) * (static_cast<float>(b) + 0.5f) / static_cast<float>(bins);
-      fill_rect(fig, bx0, base - h, std::max(bx1, bx0 + 1), base, to_bytes(scale.color(centre)));
+      fill_rect(fig, bx0, base - h, std::max(bx1, bx0 + 1), base, shown(centre));
     }
     fill_rect(fig, x0, base, x1, base + 1, axis);
   }
   if (options.colorbar) {
     for (int x = x0; x < x1; ++x) {
       const float t = static_cast<float>(x - x0) / static_cast<float>(std::max(1, x1 - x0 - 1));
-      fill_rect(fig, x, l.bar_y, x + 1, l.bar_y + l.bar_h, to_bytes(scale.color(lo + t * (hi - lo))));
+      fill_rect(fig, x, l.bar_y, x + 1, l.bar_y + l.bar_h, shown(lo + t * (hi - lo)));
     }
     const std::string lo_text = format_value(lo), hi_text = format_value(hi),
                       mid_text = format_value(0.5f * (lo + hi));

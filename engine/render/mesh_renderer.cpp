@@ -32,9 +32,17 @@ struct SoupVertex {
 };
 static_assert(sizeof(SoupVertex) == 28);
 
+// One screen-space quad of the overlay (glsl/render_overlay.vert): a.w = half width in pixels,
+// color.w = layer (0 drawn over 1 over 2 over 3; depth orders within a layer).
 struct Segment {
   glm::vec4 a, b, color;
 };
+
+glm::vec4 part_color(SkeletonPart part, float layer) {
+  const std::array<std::uint8_t, 3> c = skeleton_color(part);
+  return {static_cast<float>(c[0]) / 255.0f, static_cast<float>(c[1]) / 255.0f, static_cast<float>(c[2]) / 255.0f,
+          layer};
+}
 
 
 vk::Pipeline make_mesh_pipeline(vk::Context& ctx) {
@@ -61,6 +69,17 @@ vk::Pipeline make_overlay_pipeline(vk::Context& ctx) {
   d.color_formats = {kColorFormat};
   d.depth_format = kDepthFormat;
   d.depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL;  // points, drawn last, win over line ends
+  return vk::create_graphics_pipeline(ctx, d);
+}
+
+vk::Pipeline make_sheet_pipeline(vk::Context& ctx) {
+  vk::GraphicsPipelineDescription d;
+  d.vertex_shader = "figure_sheet.vert";
+  d.fragment_shader = "figure_sheet.frag";
+  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+  d.push_bytes = sizeof(passes::SheetPush);
+  d.color_formats = {kColorFormat};
+  d.depth_format = kDepthFormat;
   return vk::create_graphics_pipeline(ctx, d);
 }
 
@@ -111,59 +130,11 @@ ColorScale difference_scale(float limit) {
   return s;
 }
 
-std::vector<SceneView> orbit_views(const Mesh& mesh, int count, int width, int height) {
-  if (count < 1) throw InputError("a figure needs at least one view");
-  if (width < 1 || height < 1) throw InputError("the image is empty");
-  // The grid whose cells are largest (the smaller side counts); fewer rows on ties.
-  int cols = 1, best = -1;
-  for (int c = 1; c <= count; ++c) {
-    const int rows = (count + c - 1) / c;
-    const int side = std::min(width / c, height / rows);
-    if (side > best) {
-      best = side;
-      cols = c;
-    }
-  }
-  const int rows = (count + cols - 1) / cols;
-  const int cell_w = width / cols, cell_h = height / rows;
-  if (cell_w < 1 || cell_h < 1) throw InputError("the image is too small for " + std::to_string(count) + " views");
-
-  const Aabb box = bounding_box(mesh.positions);
-  const glm::vec3 center = box.center();
-  const float radius = std::max(0.5f * box.diagonal(), 1e-6f);
-  const float margin = 1.05f;
-  // The bounding sphere (with a margin) fills the cell's smaller side.
-  const float aspect = static_cast<float>(cell_w) / static_cast<float>(cell_h);
-  const float half_h = aspect >= 1.0f ? radius * margin : radius * margin / aspect;
-  const float half_w = half_h * aspect;
-  const float elevation = 20.0f * std::numbers::pi_v<float> / 180.0f;
-
-  std::vector<SceneView> views;
-  for (int i = 0; i < count; ++i) {
-    const float azimuth = (30.0f + 360.0f * static_cast<float>(i) / static_cast<float>(count)) *
-                          std::numbers::pi_v<float> / 180.0f;
-    const glm::vec3 eye_dir(std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
-                            std::cos(elevation) * std::cos(azimuth));
-    const glm::mat4 view = glm::lookAtRH(center + eye_dir * (3.0f * radius), center, glm::vec3(0, 1, 0));
-    glm::mat4 proj = glm::orthoRH_ZO(-half_w, half_w, -half_h, half_h, radius, 5.0f * radius);
-    proj[1][1] = -proj[1][1];  // Vulkan's y points down
-    SceneView v;
-    v.view_projection = proj * view;
-    v.eye = eye_dir;
-    v.x = (i % cols) * cell_w;
-    v.y = (i / cols) * cell_h;
-    v.width = cell_w;
-    v.height = cell_h;
-    v.pixels_per_unit = static_cast<float>(cell_h) / (2.0f * half_h);
-    views.push_back(v);
-  }
-  return views;
-}
-
 MeshRenderer::MeshRenderer(vk::Context& ctx)
     : ctx_(ctx),
       mesh_pipeline_(make_mesh_pipeline(ctx)),
       overlay_pipeline_(make_overlay_pipeline(ctx)),
+      sheet_pipeline_(make_sheet_pipeline(ctx)),
       transients_(ctx) {}
 
 void MeshRenderer::set_mesh(const Mesh& mesh, std::span<const float> values, SdfDomain domain,
@@ -199,10 +170,12 @@ void MeshRenderer::set_mesh(const Mesh& mesh, std::span<const float> values, Sdf
 void MeshRenderer::set_overlay(std::span<const std::array<glm::vec3, 2>> lines,
                                std::span<const glm::vec3> points) {
   std::vector<Segment> segs;
-  const glm::vec4 line_color(0.05f, 0.05f, 0.05f, 1.0f), point_color(0.55f, 0.0f, 0.55f, 1.0f);
+  const glm::vec4 line_color(0.05f, 0.05f, 0.05f, 3.0f), point_color(0.55f, 0.0f, 0.55f, 2.0f);
   for (const auto& l : lines) segs.push_back({glm::vec4(l[0], 1.5f), glm::vec4(l[1], 0.0f), line_color});
   for (const glm::vec3& p : points) segs.push_back({glm::vec4(p, 3.0f), glm::vec4(p, 0.0f), point_color});
   segment_count_ = static_cast<std::uint32_t>(segs.size());
+  sheet_vertex_count_ = 0;
+  sheets_ = {};
   if (segs.empty()) {
     segments_ = {};
     return;
@@ -210,43 +183,113 @@ void MeshRenderer::set_overlay(std::span<const std::array<glm::vec3, 2>> lines,
   segments_ = upload(ctx_, segs.data(), segs.size() * sizeof(Segment), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 }
 
+void MeshRenderer::set_skeleton(const SkeletonOverlay& s) {
+  const std::vector<SkeletonPart> parts = node_parts(s);  // validates
+  std::vector<Segment> segs;
+  const auto line = [&](std::uint32_t i, std::uint32_t j, float half_width, SkeletonPart part, float layer) {
+    segs.push_back({glm::vec4(s.nodes[i], half_width), glm::vec4(s.nodes[j], 0.0f), part_color(part, layer)});
+  };
+  // Sheet outlines under the curves, curves under the nodes, leaves and the first node on top.
+  for (const auto& t : s.sheet_triangles)
+    for (int k = 0; k < 3; ++k) line(t[static_cast<std::size_t>(k)], t[static_cast<std::size_t>((k + 1) % 3)], 0.75f,
+                                     SkeletonPart::SheetOutline, 3.0f);
+  for (const auto& e : s.edges) line(e[0], e[1], 1.5f, SkeletonPart::Curve, 2.0f);
+  for (std::uint32_t i = 0; i < parts.size(); ++i) {
+    switch (parts[i]) {
+      case SkeletonPart::Node: line(i, i, 3.0f, SkeletonPart::Node, 1.0f); break;
+      case SkeletonPart::Branch: line(i, i, 4.0f, SkeletonPart::Branch, 0.0f); break;
+      case SkeletonPart::Leaf: line(i, i, 5.0f, SkeletonPart::Leaf, 0.0f); break;
+      case SkeletonPart::First: line(i, i, 6.0f, SkeletonPart::First, 0.0f); break;
+      default: break;  // sheet nodes: their triangles show them
+    }
+  }
+  segment_count_ = static_cast<std::uint32_t>(segs.size());
+  segments_ = segs.empty() ? vk::Buffer{}
+                           : upload(ctx_, segs.data(), segs.size() * sizeof(Segment), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  std::vector<glm::vec4> corners;
+  for (const auto& t : s.sheet_triangles)
+    for (const std::uint32_t k : t) corners.emplace_back(s.nodes[k], 1.0f);
+  sheet_vertex_count_ = static_cast<std::uint32_t>(corners.size());
+  sheets_ = corners.empty() ? vk::Buffer{}
+                            : upload(ctx_, corners.data(), corners.size() * sizeof(glm::vec4),
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+}
+
+void MeshRenderer::set_points(std::span<const glm::vec3> points, float radius_px, glm::vec3 towards,
+                              glm::vec3 near_color, glm::vec3 far_color) {
+  for (const glm::vec3& p : points)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw InputError("cannot draw a point with a non-finite coordinate");
+  float lo = INFINITY, hi = -INFINITY;
+  for (const glm::vec3& p : points) {
+    lo = std::min(lo, glm::dot(p, towards));
+    hi = std::max(hi, glm::dot(p, towards));
+  }
+  std::vector<Segment> segs;
+  segs.reserve(points.size());
+  for (const glm::vec3& p : points) {
+    const float t = hi > lo ? (glm::dot(p, towards) - lo) / (hi - lo) : 1.0f;
+    segs.push_back({glm::vec4(p, radius_px), glm::vec4(p, 0.0f), glm::vec4(far_color + t * (near_color - far_color), 0.0f)});
+  }
+  point_count_ = static_cast<std::uint32_t>(segs.size());
+  points_ = segs.empty() ? vk::Buffer{}
+                         : upload(ctx_, segs.data(), segs.size() * sizeof(Segment), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+}
+
 vk::ImageHandle MeshRenderer::add_passes(vk::RenderGraph& graph, std::uint32_t width, std::uint32_t height,
                                          std::span<const SceneView> views, glm::vec3 background) {
-  if (vertex_count_ == 0) throw Error("MeshRenderer::add_passes before set_mesh");
+  if (vertex_count_ == 0 && point_count_ == 0) throw Error("MeshRenderer::add_passes before set_mesh or set_points");
   const std::uint32_t max_side = ctx_.capabilities().max_image_dimension_2d;
   if (max_side && (width > max_side || height > max_side))
     throw InputError("a " + std::to_string(width) + " x " + std::to_string(height) +
                      " image is larger than the device allows (" + std::to_string(max_side) + " pixels a side)");
   const std::vector<SceneView> v(views.begin(), views.end());
-  auto color = graph.create_image("figure.color", {kColorFormat, width, height, 1});
-  auto depth = graph.create_image("figure.depth", {kDepthFormat, width, height, 1});
-  auto vbuf = graph.import_buffer("figure.vertices", vertices_.size, host_written(vertices_));
-  auto pal = graph.import_buffer("figure.palette", palette_.size, host_written(palette_));
+  passes::FigureOutput drawn;
+  drawn.color = graph.create_image("figure.color", {kColorFormat, width, height, 1});
+  drawn.depth = graph.create_image("figure.depth", {kDepthFormat, width, height, 1});
+  bool cleared = false;
 
-  passes::FigureMeshPass mp;
-  mp.pipeline = &mesh_pipeline_;
-  mp.color = color;
-  mp.depth = depth;
-  mp.vertices = vbuf;
-  mp.palette = pal;
-  mp.views = v;
-  mp.vertex_count = vertex_count_;
-  mp.background = background;
-  mp.scale = glm::vec4(lo_, hi_, static_cast<float>(palette_size_), 0.0f);
-  passes::FigureOutput drawn = passes::add_figure_mesh_pass(graph, mp);
-  color = drawn.color;
-
-  if (segment_count_ > 0) {
+  if (vertex_count_ > 0) {
+    passes::FigureMeshPass mp;
+    mp.pipeline = &mesh_pipeline_;
+    mp.color = drawn.color;
+    mp.depth = drawn.depth;
+    mp.vertices = graph.import_buffer("figure.vertices", vertices_.size, host_written(vertices_));
+    mp.palette = graph.import_buffer("figure.palette", palette_.size, host_written(palette_));
+    mp.views = v;
+    mp.vertex_count = vertex_count_;
+    mp.background = background;
+    mp.scale = glm::vec4(lo_, hi_, static_cast<float>(palette_size_), fade_);
+    drawn = passes::add_figure_mesh_pass(graph, mp);
+    cleared = true;
+  }
+  const auto overlay = [&](const char* name, const vk::Buffer& buffer, std::uint32_t count) {
     passes::FigureOverlayPass op;
     op.pipeline = &overlay_pipeline_;
     op.color = drawn.color;
     op.depth = drawn.depth;
-    op.segments = graph.import_buffer("figure.skeleton", segments_.size, host_written(segments_));
+    op.segments = graph.import_buffer(name, buffer.size, host_written(buffer));
     op.views = v;
-    op.segment_count = segment_count_;
-    color = passes::add_figure_overlay_pass(graph, op).color;
+    op.segment_count = count;
+    if (!cleared) op.clear_color = background;
+    drawn = passes::add_figure_overlay_pass(graph, op);
+    cleared = true;
+  };
+  if (point_count_ > 0) overlay("figure.points", points_, point_count_);
+  if (sheet_vertex_count_ > 0) {
+    passes::FigureSheetPass sp;
+    sp.pipeline = &sheet_pipeline_;
+    sp.color = drawn.color;
+    sp.depth = drawn.depth;
+    sp.corners = graph.import_buffer("figure.sheets", sheets_.size, host_written(sheets_));
+    sp.views = v;
+    sp.vertex_count = sheet_vertex_count_;
+    const std::array<std::uint8_t, 3> c = skeleton_color(SkeletonPart::Sheet);
+    sp.color_value = glm::vec4(c[0] / 255.0f, c[1] / 255.0f, c[2] / 255.0f, 1.0f);
+    drawn = passes::add_figure_sheet_pass(graph, sp);
   }
-  return color;
+  if (segment_count_ > 0) overlay("figure.skeleton", segments_, segment_count_);
+  return drawn.color;
 }
 
 Image MeshRenderer::render(std::uint32_t width, std::uint32_t height, std::span<const SceneView> views,

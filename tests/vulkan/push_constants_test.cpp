@@ -69,6 +69,9 @@ TEST(PushConstants, FigureStructsMatchTheirGlslBlocks) {
   const Expected overlay{{SDFKIT_OFF(OverlayPush, view_projection), SDFKIT_OFF(OverlayPush, viewport)},
                          sizeof(OverlayPush)};
   expect_block("render_overlay.vert", overlay);
+  const Expected sheet{{SDFKIT_OFF(SheetPush, view_projection), SDFKIT_OFF(SheetPush, color)}, sizeof(SheetPush)};
+  expect_block("figure_sheet.vert", sheet);
+  expect_block("figure_sheet.frag", sheet);
 }
 
 TEST(PushConstants, ShadersWithoutABlockHaveNoneAndJunkIsRefused) {
