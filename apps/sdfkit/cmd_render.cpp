@@ -80,11 +80,15 @@ InputKind classify(const std::string& input, bool force_points) {
     if (force_points) throw UsageError("--points: " + input + " is a mesh");
     return InputKind::Mesh;
   }
+  const bool wildcard = input.find_first_of("*?") != std::string::npos;
+  if (!wildcard && !fs::exists(input)) throw InputError(input + ": no such file or directory");
   const std::string ext = lower_extension(input);
   if ((ext == ".glb" || ext == ".gltf") && fs::is_regular_file(input) && is_point_animation(input))
     return InputKind::Animation;
+  if (force_points && (ext == ".off" || ext == ".obj" || ext == ".stl" || ext == ".glb" || ext == ".gltf"))
+    throw UsageError("--points: " + input + " is a mesh file (point clouds: .ply, .xyz, .csv, .txt, frame sets)");
   if (force_points) return InputKind::Points;
-  if (fs::is_directory(input) || input.find_first_of("*?") != std::string::npos) return InputKind::Points;
+  if (fs::is_directory(input) || wildcard) return InputKind::Points;
   if (ext == ".xyz" || ext == ".csv" || ext == ".txt") return InputKind::Points;
   if (ext == ".ply" && fs::is_regular_file(input) && !ply_has_faces(input)) return InputKind::Points;
   return InputKind::Mesh;

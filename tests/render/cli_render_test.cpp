@@ -260,6 +260,9 @@ TEST_F(RenderCli, PointCloudFrameAndStripWithTheirSkeletons) {
   fails(path("frames") + " --backend opencl", 2, "--backend does not apply");
   fails(path("frames") + " --up w", 2, "--up");
   fails("builtin:sphere --strip 2", 2, "--strip and --frame need a point cloud");
+  fails(path("missing") + " --strip 2", 1, "no such file or directory");
+  std::ofstream(path("mesh.off")) << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  fails(path("mesh.off") + " --points", 2, "is a mesh file");
   std::ofstream(path("broken.json")) << R"({"frames":[{"nodes":[{"position":[0,0,0]}],"edges":[[0,4]]}]})";
   fails(path("frames/f1.xyz") + " --skeleton " + path("broken.json"), 1, "does not exist");
   std::ofstream(path("garbage.xyz")) << "1 2 3\nnot numbers at all\n";
