@@ -4,7 +4,10 @@
 
 #include "../vulkan/vk_test_util.hpp"
 
+#include "analytic.hpp"
+
 #include "sdfkit/core/shapes.hpp"
+#include "sdfkit/io/asset.hpp"
 #include "sdfkit/render/figure.hpp"
 #include "sdfkit/skeleton/models.hpp"
 
@@ -168,6 +171,52 @@ TEST_F(SkeletonPicture, ElongatedBoxesStandUpAndFillEveryView) {
       EXPECT_NEAR(0.5 * (b[0] + b[2]), 0.5 * v.width, 2.0) << "axis " << long_axis;
       EXPECT_NEAR(0.5 * (b[1] + b[3]), 0.5 * v.height, 2.0) << "axis " << long_axis;
     }
+  }
+}
+
+// CGAL meshes (a human, quadrupeds, the elephant, a knot, the armadillo, the bunny) drawn by the
+// rule in 3 views at one common scale: in every view the drawn pixels' box is the projection of
+// the vertices (computed here from the view's matrix) within 2 px, centred in the view; the
+// fullest view fills >= 90 % of its cell along its limiting side, and the others are at the same
+// scale (so a narrow view of a wide animal fills less).
+TEST_F(SkeletonPicture, RealMeshesAreFramedByTheirProjection) {
+  for (const char* name : {"man.off", "camel.off", "elephant.off", "cow.off", "knot2.off", "armadillo.off",
+                           "bunny00.off", "diplodocus.off"}) {
+    const io::Asset a = io::load_asset(test::data_mesh(name));
+    RenderOptions o;
+    o.views = 3;
+    o.width = 1200;
+    o.height = 400;
+    o.histogram = o.colorbar = false;
+    o.setup.orientation = orient(a.mesh.positions, UpRule::LongestAxis);
+    const std::vector<float> values(a.mesh.vertex_count(), 0.5f);
+    const Image img = render_figure(*ctx_, a.mesh, values, SdfDomain::Vertex, o);
+    const std::vector<SceneView> views = orbit_views(a.mesh.positions, 3, o.width, o.height, o.setup);
+    double fullest = 0.0;
+    for (const SceneView& v : views) {
+      float x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+      for (const glm::vec3& p : a.mesh.positions) {
+        const glm::vec4 c = v.view_projection * glm::vec4(p, 1.0f);
+        const float px = (0.5f * c.x / c.w + 0.5f) * static_cast<float>(v.width);
+        const float py = (0.5f * c.y / c.w + 0.5f) * static_cast<float>(v.height);
+        x0 = std::min(x0, px);
+        x1 = std::max(x1, px);
+        y0 = std::min(y0, py);
+        y1 = std::max(y1, py);
+      }
+      const std::array<int, 4> b = drawn_box(img, v, kWhite);
+      EXPECT_NEAR(b[0], x0, 2.0) << name;
+      EXPECT_NEAR(b[2], x1, 2.0) << name;
+      EXPECT_NEAR(b[1], y0, 2.0) << name;
+      EXPECT_NEAR(b[3], y1, 2.0) << name;
+      EXPECT_NEAR(0.5 * (b[0] + b[2]), 0.5 * v.width, 2.0) << name;
+      EXPECT_NEAR(0.5 * (b[1] + b[3]), 0.5 * v.height, 2.0) << name;
+      fullest = std::max(fullest, fill_share(img, v));
+    }
+    // 400 x 400 cells: the border is 3 % + 8 px a side, so the object fills up to 90 %.
+    const double border = 2.0 * (0.03 * 400 + 8.0) / 400.0;
+    EXPECT_GE(fullest, 1.0 - border - 0.01) << name;
+    EXPECT_NEAR(1.0 - border, 0.90, 1e-9);
   }
 }
 
