@@ -1,6 +1,7 @@
 // sdfkit-bench: the paper's Table 1 on this machine. Times the Vulkan and OpenCL backends, the
 // Embree reference, CGAL's sdf_values and (with --meshlab) MeshLab's GPU SDF filter on the same
 // meshes in one run; writes Markdown and JSON.
+#include "batch_bench.hpp"
 #include "bench_runner.hpp"
 #include "huge_bench.hpp"
 
@@ -66,6 +67,13 @@ int main(int argc, char** argv) {
   app.add_option("--huge-formats", huge_options.formats, "--huge: ply, obj")->delimiter(',');
   app.add_option("--huge-backend", huge_options.backend, "--huge: the backend of the runs");
   app.add_flag("--generate-only", generate_only, "--huge: only write the meshes");
+  BatchBenchOptions batch_options;
+  app.add_option("--batch", batch_options.assets,
+                 "Instead of the table: N cow-sized assets through one `sdfkit batch` (issue 15): wall, CPU, per-asset stages")
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--batch-jobs", batch_options.jobs, "--batch: batch -j")->check(CLI::Range(1, 64));
+  app.add_option("--batch-backend", batch_options.backend, "--batch: batch --backend (auto, vulkan, opencl)");
+  app.add_option("--batch-format", batch_options.format, "--batch: batch --format")->check(CLI::IsMember({"glb", "gltf", "ply", "txt"}));
   app.add_flag("--meshlab", o.meshlab, "Also time MeshLab's GPU SDF filter (meshlabserver, xvfb-run)");
   app.add_flag("--no-cgal", no_cgal, "Skip CGAL's sdf_values");
   app.add_option("--smooth", o.smooth_rings, "k of the k-ring smoothing timing (0 = off)");
@@ -86,6 +94,23 @@ int main(int argc, char** argv) {
 
   try {
     fs::create_directories(work);
+    if (app.count("--batch") > 0) {
+      batch_options.work_dir = work;
+      batch_options.rays = o.rays;
+      batch_options.sdfkit = self_dir() + "/sdfkit";
+      if (!fs::exists(batch_options.sdfkit)) batch_options.sdfkit = self_dir() + "/../sdfkit";
+      std::string table;
+      auto j = run_batch_bench(batch_options, table);
+      const std::string md = "Machine: " + cpu_name() + ", " + std::to_string(std::thread::hardware_concurrency()) +
+                             " hardware threads.\n\n" + table;
+      std::printf("%s", md.c_str());
+      if (!md_out.empty()) sdfkit::io::write_file_atomically(md_out, [&](std::ostream& os) { os << md; });
+      if (!json_out.empty()) {
+        j["machine"] = cpu_name();
+        sdfkit::io::write_file_atomically(json_out, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+      }
+      return 0;
+    }
     if (huge) {
       huge_options.work_dir = work;
       huge_options.rays = o.rays;

@@ -65,6 +65,17 @@ void add_batch_command(CLI::App& app) {
     };
     const BatchSummary s = run_batch(inputs, o, progress);
     std::printf("%zu done, %zu skipped, %zu failed; report: %s\n", s.done, s.skipped, s.failed, s.report.c_str());
+    if (s.stale_temporaries > 0)
+      std::printf("removed %zu temporary files a killed run had left\n", s.stale_temporaries);
+    if (s.done > 0) {
+      // Where the time went: the sessions once, then the mean of each stage per asset.
+      const BatchTiming& t = s.timing;
+      std::printf("%.1f s; %d backend session%s opened once in %.0f ms; per asset (mean ms):", t.wall_ms / 1000.0,
+                  t.sessions, t.sessions == 1 ? "" : "s", t.sessions_ms);
+      for (const StageTiming& st : t.mean_stages)
+        std::printf(" %s%s %.2f%s", st.nested ? "(" : "", st.stage.c_str(), st.milliseconds, st.nested ? ")" : "");
+      std::printf("\n");
+    }
     if (s.failed > 0) throw sdfkit::Error(std::to_string(s.failed) + " of " + std::to_string(inputs.size()) + " assets failed (see " + s.report + ")");
   });
 }

@@ -5,6 +5,7 @@
 
 #include <tiny_gltf.h>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -12,13 +13,18 @@
 namespace sdfkit::io::detail {
 
 // One drawn triangle primitive: mesh `mesh`'s primitive `primitive` placed by node `node`;
-// its POSITION accessor's vertices are input vertices [first_vertex, first_vertex + count).
+// its POSITION accessor's vertices are input vertices [first_vertex, first_vertex + count),
+// its triangles input triangles [first_triangle, first_triangle + triangle_count); `world` is
+// the node's world transform (column-major 4x4).
 struct GltfPrimitiveInstance {
   int node = -1;
   int mesh = -1;
   int primitive = -1;
   std::uint32_t first_vertex = 0;
   std::uint32_t vertex_count = 0;
+  std::uint32_t first_triangle = 0;
+  std::uint32_t triangle_count = 0;
+  std::array<double, 16> world{};
 };
 
 // Asset::source for glTF inputs.

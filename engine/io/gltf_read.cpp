@@ -541,6 +541,7 @@ private:
       for (std::size_t k = 0; k < count; ++k) idx[k] = static_cast<std::uint32_t>(k);
     }
 
+    const auto first_triangle = static_cast<std::uint32_t>(out_.triangles.size());
     // A mirroring transform (negative determinant) flips the winding; glTF says to flip back.
     const bool flip = glm::determinant(glm::dmat3(world)) < 0.0;
     auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
@@ -559,8 +560,12 @@ private:
     } else {
       for (std::size_t t = 1; t + 1 < idx.size(); ++t) emit(idx[t], idx[t + 1], idx[0]);
     }
-    src_.instances.push_back(GltfPrimitiveInstance{node, mesh_index, prim_index, first,
-                                                   static_cast<std::uint32_t>(count)});
+    GltfPrimitiveInstance inst{node, mesh_index, prim_index, first, static_cast<std::uint32_t>(count),
+                               first_triangle,
+                               static_cast<std::uint32_t>(out_.triangles.size() - first_triangle), {}};
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) inst.world[static_cast<std::size_t>(4 * c + r)] = world[c][r];
+    src_.instances.push_back(inst);
   }
 
   const std::string& path_;

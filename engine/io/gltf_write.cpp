@@ -13,6 +13,7 @@
 #include "sdfkit/core/error.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cctype>
 #include <cstring>
 #include <map>
@@ -218,16 +219,54 @@ tinygltf::Model write_back_model(const GltfSource& src, bool binary, const Outpu
   merge_buffers(model);
   BufferAppender appender(model);
   if (binary) move_images_into_buffer(model, appender);
-  std::map<std::pair<int, int>, bool> done;  // (mesh, primitive): first instance wins
-  std::size_t replaced_colors = 0;
+  // The drawn meshes: a node's primitives one after the other. A mesh carries the values of
+  // the first node that draws it; a node whose values differ (another scale, a transform that
+  // is no similarity) draws a copy of the mesh with its own values (same POSITION, indices and
+  // materials), one copy per distinct set of values.
+  struct Draw {
+    int node = -1, mesh = -1;
+    std::vector<const GltfPrimitiveInstance*> prims;
+  };
+  std::vector<Draw> draws;
   for (const GltfPrimitiveInstance& inst : src.instances) {
-    if (!done.emplace(std::make_pair(inst.mesh, inst.primitive), true).second) continue;
-    tinygltf::Primitive& prim = model.meshes[static_cast<std::size_t>(inst.mesh)]
-                                    .primitives[static_cast<std::size_t>(inst.primitive)];
-    if (options.color && prim.attributes.count("COLOR_0")) ++replaced_colors;
-    add_sdf_attributes(appender, prim,
-                       slice(values, inst.first_vertex, inst.vertex_count, options.color),
-                       inst.vertex_count);
+    if (draws.empty() || draws.back().node != inst.node) draws.push_back({inst.node, inst.mesh, {}});
+    draws.back().prims.push_back(&inst);
+  }
+  const auto same_values = [&](const Draw& a, const Draw& b) {
+    if (a.prims.size() != b.prims.size()) return false;
+    for (std::size_t p = 0; p < a.prims.size(); ++p) {
+      if (a.prims[p]->vertex_count != b.prims[p]->vertex_count) return false;
+      for (std::uint32_t k = 0; k < a.prims[p]->vertex_count; ++k) {
+        const float x = values.raw[a.prims[p]->first_vertex + k], y = values.raw[b.prims[p]->first_vertex + k];
+        if (std::abs(x - y) > 1e-5f * std::max({1.0f, std::abs(x), std::abs(y)})) return false;
+      }
+    }
+    return true;
+  };
+  std::map<int, std::vector<std::pair<int, const Draw*>>> variants;  // mesh: (output mesh, values)
+  std::size_t replaced_colors = 0;
+  for (const Draw& d : draws) {
+    auto& list = variants[d.mesh];
+    int target = -1;
+    for (const auto& [index, other] : list)
+      if (same_values(d, *other)) target = index;
+    if (target < 0) {
+      target = list.empty() ? d.mesh : static_cast<int>(model.meshes.size());
+      if (target != d.mesh) {
+        model.meshes.push_back(src.model.meshes[static_cast<std::size_t>(d.mesh)]);
+        model.meshes.back().name += model.meshes.back().name.empty() ? "sdf instance" : " (sdf instance)";
+      }
+      list.push_back({target, &d});
+      for (const GltfPrimitiveInstance* inst : d.prims) {
+        tinygltf::Primitive& prim = model.meshes[static_cast<std::size_t>(target)]
+                                        .primitives[static_cast<std::size_t>(inst->primitive)];
+        if (options.color && prim.attributes.count("COLOR_0")) ++replaced_colors;
+        add_sdf_attributes(appender, prim,
+                           slice(values, inst->first_vertex, inst->vertex_count, options.color),
+                           inst->vertex_count);
+      }
+    }
+    if (target != d.mesh) model.nodes[static_cast<std::size_t>(d.node)].mesh = target;
   }
   if (replaced_colors > 0)
     warnings.push_back("replaced the existing COLOR_0 of " + std::to_string(replaced_colors) +

@@ -3,6 +3,7 @@
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/core/weld.hpp"
+#include "sdfkit/io/solids.hpp"
 #include "sdfkit/post/smooth.hpp"
 
 #include <algorithm>
@@ -25,6 +26,82 @@ public:
 private:
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
+
+// The field of an asset of several solids (io/solids.hpp), on asset.mesh: each group's
+// representative solid welded on its own and computed on `session`, the other solids of the
+// group take its values times their scale. Where solids weld together in asset.mesh, the
+// later solid's value is kept. The backend's stage timings are summed into `stages`.
+SdfField compute_solids(Session& session, const io::Asset& asset, const io::SolidPlan& plan,
+                        const SdfOptions& options, std::vector<StageTiming>& stages) {
+  const bool per_vertex = options.domain == SdfDomain::Vertex;
+  const std::size_t n_in = per_vertex ? asset.input_positions.size() : asset.input_triangles.size();
+  std::vector<float> values(n_in, 0.0f);
+  std::vector<std::uint32_t> kept(n_in, 0u);
+  std::vector<std::uint8_t> filled(n_in, 0u);
+  // Input vertex or triangle indices of a solid, in its own order.
+  const auto points_of = [&](const io::Solid& s) {
+    std::vector<std::uint32_t> out;
+    for (const auto& [first, count] : per_vertex ? s.vertex_ranges : s.triangle_ranges)
+      for (std::uint32_t k = 0; k < count; ++k) out.push_back(first + k);
+    return out;
+  };
+  for (std::size_t g = 0; g < plan.representatives.size(); ++g) {
+    const io::Solid& rep = plan.solids[plan.representatives[g]];
+    std::vector<glm::vec3> positions;
+    std::vector<Triangle> triangles;
+    for (std::size_t r = 0; r < rep.vertex_ranges.size(); ++r) {
+      const auto [vfirst, vcount] = rep.vertex_ranges[r];
+      const auto [tfirst, tcount] = rep.triangle_ranges[r];
+      const auto base = static_cast<std::uint32_t>(positions.size());
+      positions.insert(positions.end(), asset.input_positions.begin() + vfirst,
+                       asset.input_positions.begin() + vfirst + vcount);
+      for (std::uint32_t t = tfirst; t < tfirst + tcount; ++t) {
+        const Triangle& in = asset.input_triangles[t];
+        triangles.push_back(Triangle{in[0] - vfirst + base, in[1] - vfirst + base, in[2] - vfirst + base});
+      }
+    }
+    WeldResult welded = weld(positions, triangles, asset.weld_tolerance);
+    session.set_mesh(std::move(welded.mesh));
+    const SdfField f = session.compute(options);
+    for (const StageTiming& t : session.backend().last_timings()) {
+      auto it = std::find_if(stages.begin(), stages.end(), [&](const StageTiming& s) { return s.stage == t.stage; });
+      if (it == stages.end()) stages.push_back(t);
+      else it->milliseconds += t.milliseconds;
+    }
+    const std::vector<std::uint32_t> rep_points = points_of(rep);
+    for (const io::Solid& s : plan.solids) {
+      if (s.group != static_cast<int>(g)) continue;
+      const std::vector<std::uint32_t> points = points_of(s);
+      if (points.size() != rep_points.size()) throw Error(asset.path + ": instances of one mesh differ in size");
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        const std::uint32_t from = per_vertex ? welded.input_to_welded[k] : static_cast<std::uint32_t>(k);
+        values[points[k]] = static_cast<float>(s.scale * static_cast<double>(f.values[from]));
+        kept[points[k]] = f.kept_rays.empty() ? 0u : f.kept_rays[from];
+        filled[points[k]] = f.filled.empty() ? 0u : f.filled[from];
+      }
+    }
+  }
+  SdfField out;
+  out.domain = options.domain;
+  if (!per_vertex) {
+    out.values = std::move(values);
+    out.kept_rays = std::move(kept);
+    out.filled = std::move(filled);
+  } else {
+    const std::size_t n = asset.mesh.positions.size();
+    out.values.assign(n, 0.0f);
+    out.kept_rays.assign(n, 0u);
+    out.filled.assign(n, 0u);
+    for (std::size_t v = 0; v < n_in; ++v) {
+      const std::uint32_t w = asset.input_to_welded[v];
+      out.values[w] = values[v];
+      out.kept_rays[w] = kept[v];
+      out.filled[w] = filled[v];
+    }
+  }
+  out.filled_count = static_cast<std::size_t>(std::count(out.filled.begin(), out.filled.end(), std::uint8_t{1}));
+  return out;
+}
 
 }  // namespace
 
@@ -112,14 +189,27 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
   report.backend_choice = session.choice().reason;
   report.stages.push_back({"device", clock.lap_ms()});
   sample("device");
-  session.set_mesh(asset.mesh);
-  const double set_mesh_ms = clock.lap_ms();
-  sample("set_mesh");
-  out.field = session.compute(request.sdf);
+  const io::SolidPlan solids = io::plan_solids(asset);
+  report.solids = solids.solids.size();
+  report.sdf_computations = solids.representatives.size();
+  double set_mesh_ms = 0, compute_ms = 0;
+  std::vector<StageTiming> backend_stages;
+  if (solids.solids.size() > 1) {
+    out.field = compute_solids(session, asset, solids, request.sdf, backend_stages);
+    sample("set_mesh");
+    compute_ms = clock.lap_ms();
+    if (backend_stages.empty()) backend_stages.push_back({"sdf", compute_ms});
+    sample("sdf");
+  } else {
+    session.set_mesh(asset.mesh);
+    set_mesh_ms = clock.lap_ms();
+    sample("set_mesh");
+    out.field = session.compute(request.sdf);
+    compute_ms = clock.lap_ms();
+    sample("sdf");
+    backend_stages = session.backend().last_timings();
+  }
   SdfField& field = out.field;
-  const double compute_ms = clock.lap_ms();
-  sample("sdf");
-  const auto backend_stages = session.backend().last_timings();
   if (backend_stages.empty()) {
     report.stages.push_back({"prepare", set_mesh_ms});
     report.stages.push_back({"sdf", compute_ms});

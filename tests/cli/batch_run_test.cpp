@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -93,6 +94,51 @@ TEST_F(BatchRun, RerunSkipsCompleteResultsAndResumesTheRest) {
   EXPECT_EQ(statuses().at("cube-ouvert.off"), "done");
   batch("--force", 7);
   EXPECT_EQ(statuses().at("cow.off"), "done");
+}
+
+TEST_F(BatchRun, TemporariesOfAKilledRunAreRemovedOnResume) {
+  fs::remove(dir_ / "in" / "broken.off");
+  ASSERT_EQ(batch("-j 2"), 0);
+  // What a SIGKILL between write and rename leaves (io::write_file_atomically's names): this
+  // batch's result, record and report temporaries, and one of an asset this batch does not
+  // own (another shard's, writing into the same directory right now).
+  const std::vector<std::string> ours = {"cow.txt.tmp-a1b2c3d4", "elephant.json.tmp-zz99zz99",
+                                         "batch-report.json.tmp-00000000"};
+  for (const auto& t : ours) std::ofstream(dir_ / "out" / t) << "partial";
+  std::ofstream(dir_ / "out" / "horse.txt.tmp-a1b2c3d4") << "another shard's";
+  std::ofstream(dir_ / "out" / "cow.txt.tmp-short") << "not a temporary name";
+  ASSERT_EQ(batch("-j 2"), 0);
+  for (const auto& t : ours) EXPECT_FALSE(fs::exists(dir_ / "out" / t)) << t;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "horse.txt.tmp-a1b2c3d4"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "cow.txt.tmp-short"));
+  std::ifstream f(dir_ / "out" / "batch-report.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j.at("stale_temporaries_removed").get<int>(), 3);
+  EXPECT_EQ(j.at("skipped").get<int>(), 3);
+}
+
+TEST_F(BatchRun, ReportSaysWhereTheTimeWentWithOneSessionPerWorker) {
+  fs::remove(dir_ / "in" / "broken.off");
+  for (int i = 0; i < 5; ++i) fs::copy_file(dir_ / "in" / "cow.off", dir_ / "in" / ("cow" + std::to_string(i) + ".off"));
+  ASSERT_EQ(batch("-j 2"), 0);
+  std::ifstream f(dir_ / "out" / "batch-report.json");
+  const auto t = nlohmann::json::parse(f).at("timing");
+  // 8 assets on 2 workers: 2 sessions (device, kernels) for the whole batch, not one per asset.
+  EXPECT_EQ(t.at("sessions").get<int>(), 2);
+  const auto& per = t.at("per_asset_mean_ms");
+  for (const char* stage : {"load", "read", "weld", "device", "bvh_build", "upload", "trace_gather", "write", "record", "other"})
+    ASSERT_TRUE(per.contains(stage)) << stage;
+  for (const auto& [stage, ms] : per.items()) EXPECT_GE(ms.get<double>(), 0.0) << stage;
+  // Stages are parts of the asset's time: their mean sum (read and weld are inside load) is
+  // the mean asset time, which two workers overlap, so it is at most twice the wall time per asset.
+  double sum = 0;
+  for (const auto& [stage, ms] : per.items())
+    if (stage != "read" && stage != "weld") sum += ms.get<double>();
+  EXPECT_LE(sum * 8, 2 * t.at("wall_ms").get<double>() + 1.0);
+  // With one job, one session.
+  ASSERT_EQ(batch("-j 1 --force"), 0);
+  std::ifstream g(dir_ / "out" / "batch-report.json");
+  EXPECT_EQ(nlohmann::json::parse(g).at("timing").at("sessions").get<int>(), 1);
 }
 
 TEST_F(BatchRun, ShardsAreDisjointAndCoverTheInputs) {

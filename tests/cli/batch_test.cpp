@@ -50,6 +50,23 @@ TEST_F(BatchPlan, TxtFilesAreManifests) {
   EXPECT_EQ(fs::path(files[0]).parent_path().filename(), "b");
 }
 
+TEST_F(BatchPlan, AtLineInAManifestIsAManifestRelativeToIt) {
+  // "@FILE" inside a manifest names another manifest relative to the listing one, as "@FILE"
+  // names one on the command line; "./@name" is a file whose name starts with '@'.
+  fs::create_directories(dir_ / "lists" / "sub");
+  std::ofstream(dir_ / "lists" / "sub" / "more.manifest") << "../../b/x.off\n";
+  std::ofstream(dir_ / "lists" / "@odd.off") << "x";
+  std::ofstream(dir_ / "lists" / "main.list") << "@sub/more.manifest\n./@odd.off\n../a/x.off\n";
+  const auto files = expand_inputs({"@" + (dir_ / "lists" / "main.list").string()});
+  ASSERT_EQ(files.size(), 3u);
+  std::set<std::string> got;
+  for (const auto& f : files) got.insert(fs::relative(f, dir_).string());
+  EXPECT_EQ(got, (std::set<std::string>{"a/x.off", "b/x.off", "lists/@odd.off"}));
+  // Without the rule the line would be the file "lists/@sub/more.manifest", which is missing.
+  std::ofstream(dir_ / "lists" / "lone.list") << "@\n";
+  EXPECT_THROW(expand_inputs({(dir_ / "lists" / "lone.list").string()}), InputError);
+}
+
 TEST_F(BatchPlan, MissingInputIsAnError) {
   EXPECT_THROW(expand_inputs({(dir_ / "nope").string()}), InputError);
   std::ofstream(dir_ / "bad.list") << "missing.off\n";

@@ -125,7 +125,8 @@ TEST_P(WriteGltfBack, KeepsTheModelAndAddsSdfAttributes) {
   io::write_field(out, a, field);
   const std::vector<std::string> logged = warnings.messages();
   ASSERT_EQ(logged.size(), 1u);
-  EXPECT_NE(logged[0].find("replaced the existing COLOR_0 of 1 primitives"), std::string::npos);
+  // The mesh and its copy for the second instance (whose ramp values differ) both had COLOR_0.
+  EXPECT_NE(logged[0].find("replaced the existing COLOR_0 of 2 primitives"), std::string::npos);
   EXPECT_EQ(std::vector<std::string>{"result." + GetParam()}, [&] {
     std::vector<std::string> names;
     for (const auto& e : std::filesystem::directory_iterator(dir.path("out")))
@@ -153,7 +154,19 @@ TEST_P(WriteGltfBack, KeepsTheModelAndAddsSdfAttributes) {
   ASSERT_EQ(m.images.size(), 2u);
   EXPECT_EQ(std::string(m.images[0].image.begin(), m.images[0].image.end()), in.image0_bytes);
   EXPECT_EQ(std::string(m.images[1].image.begin(), m.images[1].image.end()), in.image1_bytes);
-  ASSERT_EQ(m.meshes.size(), 1u);
+  // The child node's values differ from the root's: it draws a copy of the mesh (same
+  // POSITION and material) that carries its own.
+  ASSERT_EQ(m.meshes.size(), 2u);
+  EXPECT_EQ(m.nodes[0].mesh, 0);
+  EXPECT_EQ(m.nodes[1].mesh, 1);
+  {
+    const tinygltf::Primitive& copy = m.meshes[1].primitives.at(0);
+    EXPECT_EQ(copy.attributes.at("POSITION"), m.meshes[0].primitives.at(0).attributes.at("POSITION"));
+    EXPECT_EQ(copy.material, 0);
+    const std::vector<float> sdf1 = floats_of(m, copy.attributes.at("_SDF"));
+    ASSERT_EQ(sdf1.size(), 6u);
+    for (std::size_t v = 0; v < 6; ++v) EXPECT_EQ(sdf1[v], vertex_value(a, field, v + 6));
+  }
   const tinygltf::Primitive& prim = m.meshes[0].primitives.at(0);
   EXPECT_EQ(prim.material, 0);
   for (const char* name : {"POSITION", "TEXCOORD_0", "COLOR_0", "_SDF", "_SDF_NORMALIZED"})

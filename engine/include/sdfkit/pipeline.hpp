@@ -68,6 +68,9 @@ struct ComputeReport {
   // smooth, write. The peak is the process's so far, so a step's own peak shows where it grows.
   std::vector<StageMemory> memory;
   std::size_t filled_points = 0;    // points with no accepted ray, filled from neighbours
+  // The asset's solids (io/solids.hpp: a glTF node drawing a mesh is one) and the SDF
+  // computations they took: one per (mesh, similarity class).
+  std::size_t solids = 1, sdf_computations = 1;
   FieldSummary summary;
   std::vector<std::string> warnings;
 };

@@ -121,7 +121,8 @@ void check_output(const std::string& out_path, SdfDomain domain);
 //    textures, other attributes, extensions, node hierarchy) with, on every triangle primitive,
 //    the attributes _SDF (FLOAT SCALAR, model units), _SDF_NORMALIZED ([0,1]) and, with
 //    options.color, COLOR_0 (VEC3 float; an existing COLOR_0 is replaced, with a warning). A
-//    mesh instanced by several nodes stores the values of its first instance. Other inputs get
+//    mesh instanced by several nodes carries the values of the first node drawing it; a node
+//    whose values differ draws a copy of the mesh with its own (io/solids.hpp). Other inputs get
 //    a fresh minimal glTF: one mesh, one node, one buffer. Either output is one
 //    self-contained file: a single buffer (the BIN chunk of a .glb, a base64 data URI in a
 //    .gltf); images read from files or data URIs are stored in that buffer (.glb) or as data
