@@ -1,4 +1,5 @@
 #include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/parallel.hpp"
 
 #include "sdfkit/core/error.hpp"
 
@@ -40,24 +41,28 @@ bool in_range(const Mesh& mesh, const Triangle& t) {
 
 std::vector<std::uint8_t> degenerate_faces(const Mesh& mesh) {
   std::vector<std::uint8_t> out(mesh.triangles.size(), 0);
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    const Triangle& t = mesh.triangles[f];
-    out[f] = !in_range(mesh, t) ||
-             triangle_is_degenerate(mesh.positions[t[0]], mesh.positions[t[1]],
-                                    mesh.positions[t[2]]);
-  }
+  parallel_for(mesh.triangles.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      const Triangle& t = mesh.triangles[f];
+      out[f] = !in_range(mesh, t) ||
+               triangle_is_degenerate(mesh.positions[t[0]], mesh.positions[t[1]],
+                                      mesh.positions[t[2]]);
+    }
+  }, 1 << 16);
   return out;
 }
 
 std::vector<glm::vec3> face_normals(const Mesh& mesh) {
   std::vector<glm::vec3> out(mesh.triangles.size(), glm::vec3(0.0f));
   const auto degenerate = degenerate_faces(mesh);
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    if (degenerate[f]) continue;
-    const Triangle& t = mesh.triangles[f];
-    const glm::vec3& a = mesh.positions[t[0]];
-    out[f] = glm::normalize(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
-  }
+  parallel_for(mesh.triangles.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      if (degenerate[f]) continue;
+      const Triangle& t = mesh.triangles[f];
+      const glm::vec3& a = mesh.positions[t[0]];
+      out[f] = glm::normalize(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
+    }
+  }, 1 << 16);
   return out;
 }
 
