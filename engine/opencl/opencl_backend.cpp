@@ -20,6 +20,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <thread>
 
 namespace sdfkit::cl {
 
@@ -136,12 +137,24 @@ std::uint32_t morton3(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& 
 std::vector<std::uint32_t> spatial_order(std::span<const glm::vec3> points) {
   const Aabb box = bounding_box(points);
   const glm::vec3 inv = 1.0f / glm::max(box.extent(), glm::vec3(std::numeric_limits<float>::min()));
-  std::vector<std::uint64_t> keyed(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i)
-    keyed[i] = (std::uint64_t{morton3(points[i], box.min, inv)} << 32) | i;
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<std::uint32_t> order(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
+  const std::size_t n = points.size();
+  std::vector<std::uint64_t> keyed(n);
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) keyed[i] = (std::uint64_t{morton3(points[i], box.min, inv)} << 32) | i;
+  }, 1 << 16);
+  // The keys are distinct (the index is in them): the halves sorted on two threads and merged
+  // give the order of one sort.
+  const auto half = keyed.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  if (n >= (std::size_t{1} << 16)) {
+    std::thread other([&] { std::sort(keyed.begin(), half); });
+    std::sort(half, keyed.end());
+    other.join();
+    std::inplace_merge(keyed.begin(), half, keyed.end());
+  } else {
+    std::sort(keyed.begin(), keyed.end());
+  }
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
   return order;
 }
 
