@@ -89,29 +89,33 @@ float corner_angle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
 
 std::vector<glm::vec3> vertex_normals(const Mesh& mesh) {
   std::vector<glm::dvec3> sum(mesh.positions.size(), glm::dvec3(0.0));
-  const auto normals = face_normals(mesh);
-  // The corner angles (the costly part) of a block of faces on all threads, then added in face
-  // order on this one: the sums, and so the normals, are those of a sequential loop.
+  // The face normals (face_normals' values) and corner angles (the costly part) of a block of
+  // faces on all threads, then added in face order on this one: the sums, and so the normals,
+  // are those of a sequential loop, without an array of all face normals beside them.
   constexpr std::size_t kBlock = std::size_t{1} << 18;
-  std::vector<std::array<float, 3>> angles(std::min(kBlock, mesh.triangles.size()));
+  std::vector<glm::vec3> normals(std::min(kBlock, mesh.triangles.size()));
+  std::vector<std::array<float, 3>> angles(normals.size());
   for (std::size_t first = 0; first < mesh.triangles.size(); first += kBlock) {
     const std::size_t count = std::min(kBlock, mesh.triangles.size() - first);
     parallel_for(count, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        const std::size_t f = first + i;
-        if (normals[f] == glm::vec3(0.0f)) continue;
-        const Triangle& t = mesh.triangles[f];
+        const Triangle& t = mesh.triangles[first + i];
+        normals[i] = glm::vec3(0.0f);
+        if (!in_range(mesh, t)) continue;
+        const glm::vec3& a = mesh.positions[t[0]];
+        if (triangle_is_degenerate(a, mesh.positions[t[1]], mesh.positions[t[2]])) continue;
+        normals[i] = glm::normalize(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
+        if (normals[i] == glm::vec3(0.0f)) continue;
         for (int k = 0; k < 3; ++k)
           angles[i][static_cast<std::size_t>(k)] = corner_angle(
               mesh.positions[t[k]], mesh.positions[t[(k + 1) % 3]], mesh.positions[t[(k + 2) % 3]]);
       }
     }, 1 << 14);
     for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t f = first + i;
-      if (normals[f] == glm::vec3(0.0f)) continue;
-      const Triangle& t = mesh.triangles[f];
+      if (normals[i] == glm::vec3(0.0f)) continue;
+      const Triangle& t = mesh.triangles[first + i];
       for (int k = 0; k < 3; ++k)
-        sum[t[k]] += glm::dvec3(normals[f]) * static_cast<double>(angles[i][static_cast<std::size_t>(k)]);
+        sum[t[k]] += glm::dvec3(normals[i]) * static_cast<double>(angles[i][static_cast<std::size_t>(k)]);
     }
   }
   std::vector<glm::vec3> out(mesh.positions.size(), glm::vec3(0.0f));
