@@ -1,10 +1,12 @@
 #include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/parallel.hpp"
 
 #include "sdfkit/core/error.hpp"
 
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -40,24 +42,28 @@ bool in_range(const Mesh& mesh, const Triangle& t) {
 
 std::vector<std::uint8_t> degenerate_faces(const Mesh& mesh) {
   std::vector<std::uint8_t> out(mesh.triangles.size(), 0);
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    const Triangle& t = mesh.triangles[f];
-    out[f] = !in_range(mesh, t) ||
-             triangle_is_degenerate(mesh.positions[t[0]], mesh.positions[t[1]],
-                                    mesh.positions[t[2]]);
-  }
+  parallel_for(mesh.triangles.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      const Triangle& t = mesh.triangles[f];
+      out[f] = !in_range(mesh, t) ||
+               triangle_is_degenerate(mesh.positions[t[0]], mesh.positions[t[1]],
+                                      mesh.positions[t[2]]);
+    }
+  }, 1 << 16);
   return out;
 }
 
 std::vector<glm::vec3> face_normals(const Mesh& mesh) {
   std::vector<glm::vec3> out(mesh.triangles.size(), glm::vec3(0.0f));
   const auto degenerate = degenerate_faces(mesh);
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    if (degenerate[f]) continue;
-    const Triangle& t = mesh.triangles[f];
-    const glm::vec3& a = mesh.positions[t[0]];
-    out[f] = glm::normalize(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
-  }
+  parallel_for(mesh.triangles.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      if (degenerate[f]) continue;
+      const Triangle& t = mesh.triangles[f];
+      const glm::vec3& a = mesh.positions[t[0]];
+      out[f] = glm::normalize(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
+    }
+  }, 1 << 16);
   return out;
 }
 
@@ -83,15 +89,33 @@ float corner_angle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
 
 std::vector<glm::vec3> vertex_normals(const Mesh& mesh) {
   std::vector<glm::dvec3> sum(mesh.positions.size(), glm::dvec3(0.0));
-  const auto normals = face_normals(mesh);
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    if (normals[f] == glm::vec3(0.0f)) continue;
-    const Triangle& t = mesh.triangles[f];
-    for (int k = 0; k < 3; ++k) {
-      const glm::vec3& a = mesh.positions[t[k]];
-      const glm::vec3& b = mesh.positions[t[(k + 1) % 3]];
-      const glm::vec3& c = mesh.positions[t[(k + 2) % 3]];
-      sum[t[k]] += glm::dvec3(normals[f]) * static_cast<double>(corner_angle(a, b, c));
+  // The face normals (face_normals' values) and corner angles (the costly part) of a block of
+  // faces on all threads, then added in face order on this one: the sums, and so the normals,
+  // are those of a sequential loop, without an array of all face normals beside them.
+  constexpr std::size_t kBlock = std::size_t{1} << 18;
+  std::vector<glm::vec3> normals(std::min(kBlock, mesh.triangles.size()));
+  std::vector<std::array<float, 3>> angles(normals.size());
+  for (std::size_t first = 0; first < mesh.triangles.size(); first += kBlock) {
+    const std::size_t count = std::min(kBlock, mesh.triangles.size() - first);
+    parallel_for(count, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const Triangle& t = mesh.triangles[first + i];
+        normals[i] = glm::vec3(0.0f);
+        if (!in_range(mesh, t)) continue;
+        const glm::vec3& a = mesh.positions[t[0]];
+        if (triangle_is_degenerate(a, mesh.positions[t[1]], mesh.positions[t[2]])) continue;
+        normals[i] = glm::normalize(glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
+        if (normals[i] == glm::vec3(0.0f)) continue;
+        for (int k = 0; k < 3; ++k)
+          angles[i][static_cast<std::size_t>(k)] = corner_angle(
+              mesh.positions[t[k]], mesh.positions[t[(k + 1) % 3]], mesh.positions[t[(k + 2) % 3]]);
+      }
+    }, 1 << 14);
+    for (std::size_t i = 0; i < count; ++i) {
+      if (normals[i] == glm::vec3(0.0f)) continue;
+      const Triangle& t = mesh.triangles[first + i];
+      for (int k = 0; k < 3; ++k)
+        sum[t[k]] += glm::dvec3(normals[i]) * static_cast<double>(angles[i][static_cast<std::size_t>(k)]);
     }
   }
   std::vector<glm::vec3> out(mesh.positions.size(), glm::vec3(0.0f));

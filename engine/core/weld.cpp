@@ -9,6 +9,9 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <span>
+#include <thread>
+#include <vector>
 
 namespace sdfkit {
 namespace {
@@ -55,14 +58,26 @@ public:
     head_.assign(size, kNone);
     mask_ = size - 1;
   }
-  // Pushes vertex v on its bucket's chain. Inserted in decreasing index order, every chain
-  // lists its vertices in increasing order: a lookup for vertex i stops at the first index >= i,
-  // and the first match it meets is the earliest (so 20k copies of one point cost 20k steps,
-  // not 20k^2).
-  void insert(std::uint64_t hash, std::uint32_t v) {
-    std::uint32_t& head = head_[hash & mask_];
-    next_[v] = head;
-    head = v;
+  // Pushes vertices n-1 .. 0 (hashes[v] for vertex v) on their buckets' chains. Inserted in
+  // decreasing index order, every chain lists its vertices in increasing order: a lookup for
+  // vertex i stops at the first index >= i, and the first match it meets is the earliest (so 20k
+  // copies of one point cost 20k steps, not 20k^2). On all threads: each thread takes one range
+  // of buckets and pushes its vertices in that same order, so the chains do not depend on the
+  // thread count.
+  void insert_all(std::span<const std::uint64_t> hashes) {
+    const std::size_t threads = hashes.size() < (std::size_t{1} << 16) ? 1 : std::max(1u, std::thread::hardware_concurrency());
+    const std::size_t buckets = mask_ + 1;
+    parallel_for(threads, [&](std::size_t tb, std::size_t te) {
+      for (std::size_t t = tb; t < te; ++t) {
+        const std::size_t lo = buckets * t / threads, hi = buckets * (t + 1) / threads;
+        for (std::size_t i = hashes.size(); i-- > 0;) {
+          const std::size_t b = hashes[i] & mask_;
+          if (b < lo || b >= hi) continue;
+          next_[i] = head_[b];
+          head_[b] = static_cast<std::uint32_t>(i);
+        }
+      }
+    }, 1);
   }
   // Brings the bucket's head into the cache ahead of use: the table is far larger than the
   // caches, and overlapping these misses is what makes the passes fast.
@@ -131,11 +146,13 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
 
   constexpr std::size_t kGrain = 1 << 15;
   constexpr std::size_t kAhead = 16;  // prefetch distance, vertices
-  // Sequential, in decreasing order (see Buckets::insert); the hashes are computed ahead on all
-  // threads only where that pays.
-  for (std::size_t i = n; i-- > 0;) {
-    if (i >= kAhead) buckets.prefetch(hash_of(positions[i - kAhead]));
-    buckets.insert(hash_of(positions[i]), static_cast<std::uint32_t>(i));
+  // In decreasing order (see Buckets::insert), bucket ranges on all threads.
+  {
+    std::vector<std::uint64_t> hashes(n);
+    parallel_for(n, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) hashes[i] = hash_of(positions[i]);
+    }, kGrain);
+    buckets.insert_all(hashes);
   }
 
   // rep[i]: the input vertex that i welds to. First pass, in parallel: a vertex with no earlier

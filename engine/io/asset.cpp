@@ -141,9 +141,11 @@ std::uint64_t available_memory() {
 }  // namespace
 
 void check_mesh_fits(const std::string& path, std::uint64_t vertices, std::uint64_t triangles) {
-  // Measured on the 13.3M-triangle armadillo (sdfkit bench --huge): ~100 bytes per triangle at
-  // the peak with half as many vertices; the per-vertex part covers meshes of split vertices.
-  constexpr double kBytesPerVertex = 64.0, kBytesPerTriangle = 96.0;
+  // Measured on the 13.3M-triangle armadillo (6.7M vertices, sdfkit bench --huge, 30 rays per
+  // vertex): a peak of 2539 MiB, 200 bytes per triangle (2858 MiB with 1 ray, where filling
+  // the points without a hit adds the mesh's adjacency). This estimate gives 2894 MiB there; the
+  // per-vertex part covers meshes of split vertices. A 50M-triangle mesh: about 10.6 GiB.
+  constexpr double kBytesPerVertex = 96.0, kBytesPerTriangle = 180.0;
   const double need = kBytesPerVertex * static_cast<double>(vertices) + kBytesPerTriangle * static_cast<double>(triangles);
   const std::uint64_t avail = available_memory();
   if (avail == 0 || need <= static_cast<double>(avail)) return;

@@ -59,7 +59,22 @@ struct Split {
   Box bounds;
   bool leaf = true;
   std::size_t mid = 0;
+  // Bounds and centroid bounds of [begin, mid) and [mid, end), when the partition measured
+  // them (SAH splits); an object-median split leaves them to the children's own pass.
+  bool children_measured = false;
+  Box child_bounds[2], child_cbounds[2];
 };
+
+// What a node already knows of its triangles: their bounds and centroid bounds (from its
+// parent's partition), or nothing (measured by a pass of its own).
+struct Known {
+  const Box* bounds = nullptr;
+  const Box* cbounds = nullptr;
+};
+Known child_known(const Split& s, int side) {
+  if (!s.children_measured) return {};
+  return {&s.child_bounds[side], &s.child_cbounds[side]};
+}
 
 // Nodes of one subtree, depth-first, indices local to `nodes`.
 struct Subtree {
@@ -127,12 +142,47 @@ struct Builder {
         }
   }
 
+  // Partitions refs [begin, end) by `left` in place (the same element order as libstdc++'s
+  // std::partition, which this replaced: the tree and its triangle order are unchanged) and
+  // measures both sides on the way, so that the children need no pass of their own.
+  template <class Pred>
+  std::size_t partition_measured(std::size_t begin, std::size_t end, Split& s, Pred left) {
+    Box* bb = s.child_bounds;
+    Box* cb = s.child_cbounds;
+    const auto take = [&](const Ref& r, int side) {
+      bb[side].grow(Box{r.lo, r.hi});
+      cb[side].grow(r.centroid());
+    };
+    s.children_measured = true;
+    std::size_t first = begin, last = end;
+    for (;;) {
+      for (;;) {
+        if (first == last) return first;
+        if (!left(refs[first])) break;
+        take(refs[first], 0);
+        ++first;
+      }
+      take(refs[first], 1);
+      --last;
+      for (;;) {
+        if (first == last) return first;
+        if (left(refs[last])) break;
+        take(refs[last], 1);
+        --last;
+      }
+      take(refs[last], 0);
+      std::swap(refs[first], refs[last]);
+      ++first;
+    }
+  }
+
   // Bounds of refs [begin, end) and the split the SAH (or the object median) chooses; a split
   // partitions the range in place. Subtrees over disjoint ranges may be built concurrently.
-  Split choose(std::size_t begin, std::size_t end, int depth) {
+  Split choose(std::size_t begin, std::size_t end, int depth, Known known = {}) {
     Split s;
     Box cbounds;
-    measure(begin, end, s.bounds, cbounds);
+    if (known.bounds) s.bounds = *known.bounds, cbounds = *known.cbounds;
+    else measure(begin, end, s.bounds, cbounds);
     const std::size_t n = end - begin;
     if (n <= 1) return s;
     std::size_t mid = begin;
@@ -181,16 +231,15 @@ struct Builder {
       if (n <= static_cast<std::size_t>(params.leaf_size) && (best_axis < 0 || split_cost >= leaf_cost)) return s;
       if (best_axis >= 0) {
         const float sc = scale[best_axis], lo = cbounds.lo[best_axis];
-        const auto it = std::partition(refs.begin() + static_cast<std::ptrdiff_t>(begin),
-                                       refs.begin() + static_cast<std::ptrdiff_t>(end), [&](const Ref& r) {
-                                         return std::min(bins - 1, static_cast<int>((r.centroid()[best_axis] - lo) * sc)) <= best_split;
-                                       });
-        mid = static_cast<std::size_t>(it - refs.begin());
+        mid = partition_measured(begin, end, s, [&](const Ref& r) {
+          return std::min(bins - 1, static_cast<int>((r.centroid()[best_axis] - lo) * sc)) <= best_split;
+        });
       }
     } else if (n <= static_cast<std::size_t>(params.leaf_size)) {
       return s;
     }
     if (mid == begin || mid == end) {
+      s.children_measured = false;
       // Object median along the longest centroid axis (or by index when all coincide).
       const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
       mid = begin + n / 2;
@@ -207,19 +256,19 @@ struct Builder {
   }
 
   // Fills node `index` of `t` (already allocated) with refs [begin, end), depth-first.
-  void build(Subtree& t, std::uint32_t index, std::size_t begin, std::size_t end, int depth) {
+  void build(Subtree& t, std::uint32_t index, std::size_t begin, std::size_t end, int depth, Known known) {
     t.depth = std::max(t.depth, depth);
-    const Split s = choose(begin, end, depth);
+    const Split s = choose(begin, end, depth, known);
     set_bounds(t.nodes[index], s.bounds);
     if (s.leaf) return make_leaf(t, index, begin, end);
     const auto left = static_cast<std::uint32_t>(t.nodes.size());
     t.nodes.emplace_back();
-    build(t, left, begin, s.mid, depth + 1);
+    build(t, left, begin, s.mid, depth + 1, child_known(s, 0));
     const auto right = static_cast<std::uint32_t>(t.nodes.size());
     t.nodes.emplace_back();
     t.nodes[index].first_or_second = right;
     t.nodes[index].count = 0;
-    build(t, right, s.mid, end, depth + 1);
+    build(t, right, s.mid, end, depth + 1, child_known(s, 1));
   }
 
   static void set_bounds(BvhNode& node, const Box& b) {
@@ -240,24 +289,30 @@ struct Builder {
     int depth = 0;
     int child[2] = {-1, -1};  // internal: Top indices
     int task = -1;             // a part built as a task
+    bool known = false;        // a task's bounds, measured by its parent's partition
+    Box bounds, cbounds;
   };
   int split_top(std::vector<Top>& top, std::vector<int>& tasks, std::size_t begin, std::size_t end, int depth,
-                std::size_t task_size) {
+                std::size_t task_size, Known known) {
     const int index = static_cast<int>(top.size());
     top.push_back({});
     top[static_cast<std::size_t>(index)].begin = begin;
     top[static_cast<std::size_t>(index)].end = end;
     top[static_cast<std::size_t>(index)].depth = depth;
     if (end - begin <= task_size) {
-      top[static_cast<std::size_t>(index)].task = static_cast<int>(tasks.size());
+      Top& t = top[static_cast<std::size_t>(index)];
+      t.task = static_cast<int>(tasks.size());
+      if (known.bounds) t.known = true, t.bounds = *known.bounds, t.cbounds = *known.cbounds;
       tasks.push_back(index);
       return index;
     }
-    const Split s = choose(begin, end, depth);
+    const Split s = choose(begin, end, depth, known);
     top[static_cast<std::size_t>(index)].split = s;
     if (s.leaf) return index;
-    const int l = split_top(top, tasks, begin, s.mid, depth + 1, task_size);
-    const int r = split_top(top, tasks, s.mid, end, depth + 1, task_size);
+    const int l = split_top(top, tasks, begin, s.mid, depth + 1, task_size,
+                            child_known(s, 0));
+    const int r = split_top(top, tasks, s.mid, end, depth + 1, task_size,
+                            child_known(s, 1));
     top[static_cast<std::size_t>(index)].child[0] = l;
     top[static_cast<std::size_t>(index)].child[1] = r;
     return index;
@@ -275,7 +330,7 @@ struct Builder {
                                                                       : n / (16 * threads);
     std::vector<Top> top;
     std::vector<int> tasks;
-    split_top(top, tasks, 0, n, 0, task_size);
+    split_top(top, tasks, 0, n, 0, task_size, {});
     std::vector<Subtree> parts(tasks.size());
     // Largest parts first.
     std::vector<std::size_t> schedule(tasks.size());
@@ -291,7 +346,7 @@ struct Builder {
         const Top& t = top[static_cast<std::size_t>(tasks[schedule[k]])];
         Subtree& part = parts[schedule[k]];
         part.nodes.emplace_back();
-        build(part, 0, t.begin, t.end, t.depth);
+        build(part, 0, t.begin, t.end, t.depth, t.known ? Known{&t.bounds, &t.cbounds} : Known{});
       }
     };
     {
@@ -364,9 +419,9 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
   for (std::uint8_t d : degenerate) kept += d == 0;
   b.refs.resize(kept);
   // Unpadded boxes, in face order, and the padding (as before: of the boxes' corners).
-  std::vector<std::size_t> slot_of(mesh.triangles.size() + 1, 0);
+  std::vector<std::uint32_t> slot_of(mesh.triangles.size() + 1, 0);
   for (std::size_t f = 0, k = 0; f < mesh.triangles.size(); ++f) {
-    slot_of[f] = k;
+    slot_of[f] = static_cast<std::uint32_t>(k);
     k += degenerate[f] == 0;
   }
   std::vector<float> largest(std::thread::hardware_concurrency() + 1, 0.0f);

@@ -8,6 +8,7 @@
 #include "sdfkit/core/sdf_definition.hpp"
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
 #include <glm/vec4.hpp>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <thread>
 
 namespace sdfkit::cl {
 
@@ -104,6 +106,11 @@ void set_args(cl_kernel kernel, const char* kernel_name, const Args&... args) {
 constexpr std::size_t kCpuWorkGroup = 8;
 // Points per work item of trace_bundles (sdf_definition_shared.h).
 constexpr std::size_t kBundle = SDFKIT_BUNDLE_WIDTH;
+// Most points per batch on CPU devices, whose buffers are host memory beside the process's own:
+// 2^18 points at 30 rays are 70 MiB of batch buffers instead of the 512 MiB cap, and a batch
+// still traces for seconds on a 2-core CPU at that size, so the launches cost nothing. A
+// multiple of kBundle: the bundles are the same as in one batch.
+constexpr std::size_t kCpuBatchPoints = std::size_t{1} << 18;
 
 std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m - 1) / m * m; }
 
@@ -130,12 +137,24 @@ std::uint32_t morton3(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& 
 std::vector<std::uint32_t> spatial_order(std::span<const glm::vec3> points) {
   const Aabb box = bounding_box(points);
   const glm::vec3 inv = 1.0f / glm::max(box.extent(), glm::vec3(std::numeric_limits<float>::min()));
-  std::vector<std::uint64_t> keyed(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i)
-    keyed[i] = (std::uint64_t{morton3(points[i], box.min, inv)} << 32) | i;
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<std::uint32_t> order(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
+  const std::size_t n = points.size();
+  std::vector<std::uint64_t> keyed(n);
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) keyed[i] = (std::uint64_t{morton3(points[i], box.min, inv)} << 32) | i;
+  }, 1 << 16);
+  // The keys are distinct (the index is in them): the halves sorted on two threads and merged
+  // give the order of one sort.
+  const auto half = keyed.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  if (n >= (std::size_t{1} << 16)) {
+    std::thread other([&] { std::sort(keyed.begin(), half); });
+    std::sort(half, keyed.end());
+    other.join();
+    std::inplace_merge(keyed.begin(), half, keyed.end());
+  } else {
+    std::sort(keyed.begin(), keyed.end());
+  }
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
   return order;
 }
 
@@ -160,8 +179,10 @@ struct OpenClBackend::Impl {
   bool bundles = false;  // BVH traced by trace_bundles
   std::size_t local_size = 0;  // work-group size of the trace and gather kernels (0 = driver's)
 
-  // Geometry (resident between computes).
+  // Geometry (resident between computes). The positions are kept only while the geometry is
+  // built (update_positions brings all of them again): the triangles are what a refit needs.
   Mesh mesh;
+  std::size_t vertex_count = 0;
   bool has_mesh = false;
   Octree octree;
   Bvh bvh;
@@ -317,7 +338,6 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
   }
   // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w; written
   // straight into the mapped device buffer (no host copy of 48 bytes per triangle beside it).
-  const std::vector<glm::vec3> normals_f = face_normals(mesh);
   const std::size_t record_bytes = 3 * order->size() * sizeof(glm::vec4);
   tris.reserve(ctx, std::max<std::size_t>(record_bytes, 16), CL_MEM_READ_ONLY, "triangles");
   if (record_bytes > 0) {
@@ -331,9 +351,11 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
         const std::uint32_t f = (*order)[k];
         const auto& t = mesh.triangles[f];
         const glm::vec3 a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
-        records[3 * k] = glm::vec4(a, normals_f[f].x);
-        records[3 * k + 1] = glm::vec4(b - a, normals_f[f].y);
-        records[3 * k + 2] = glm::vec4(c - a, normals_f[f].z);
+        // face_normals' normal, computed here instead of in an array of all faces beside the records.
+        const glm::vec3 nf = triangle_is_degenerate(a, b, c) ? glm::vec3(0.0f) : glm::normalize(glm::cross(b - a, c - a));
+        records[3 * k] = glm::vec4(a, nf.x);
+        records[3 * k + 1] = glm::vec4(b - a, nf.y);
+        records[3 * k + 2] = glm::vec4(c - a, nf.z);
       }
     }, 1 << 16);
     check(clEnqueueUnmapMemObject(queue.get(), tris.get(), mapped, 0, nullptr, nullptr),
@@ -376,22 +398,27 @@ const Bvh& OpenClBackend::bvh() const { return impl_->bvh; }
 
 void OpenClBackend::set_mesh(const Mesh& mesh) {
   validate_mesh(mesh, "the mesh given to the OpenCL backend");
-  impl_->mesh = mesh;
-  impl_->has_mesh = true;
+  impl_->has_mesh = false;
+  impl_->mesh.triangles = mesh.triangles;
+  impl_->mesh.positions = mesh.positions;
+  impl_->vertex_count = mesh.positions.size();
   impl_->rebuild_geometry(false);
+  impl_->mesh.positions = {};
+  impl_->has_mesh = true;
 }
 
 void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
   if (!impl_->has_mesh) throw Error("update_positions was called before set_mesh");
-  if (positions.size() != impl_->mesh.positions.size())
+  if (positions.size() != impl_->vertex_count)
     throw Error("update_positions got " + std::to_string(positions.size()) +
-                " positions for a mesh of " + std::to_string(impl_->mesh.positions.size()) +
+                " positions for a mesh of " + std::to_string(impl_->vertex_count) +
                 " vertices");
   for (const glm::vec3& p : positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw InputError("update_positions got a non-finite coordinate");
   impl_->mesh.positions.assign(positions.begin(), positions.end());
   impl_->rebuild_geometry(true);
+  impl_->mesh.positions = {};
 }
 
 std::size_t OpenClBackend::batch_points(int rays) const {
@@ -402,6 +429,7 @@ std::size_t OpenClBackend::batch_points(int rays) const {
   n = std::min(n, impl_->max_alloc / (sizeof(cl_ulong) * static_cast<std::size_t>(rays)));
   n = std::min(n, static_cast<std::size_t>(std::numeric_limits<std::uint32_t>::max()) /
                       static_cast<std::size_t>(rays));
+  if (impl_->info.type == "CPU") n = std::min(n, kCpuBatchPoints);
   if (n == 0)
     throw InputError("the OpenCL memory cap of " + std::to_string(impl_->config.memory_cap) +
                      " bytes is too small for one point with " + std::to_string(rays) + " rays");
@@ -440,20 +468,28 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
   // Points are traced in Morton order of their origins (neighbouring work items meet the same
   // nodes and triangles, which keeps them in cache); the results go back to query order.
   const std::vector<std::uint32_t> order = spatial_order(query.origins);
-  std::vector<glm::vec4> pts(n), nrm(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t q = order[i];
-    pts[i] = glm::vec4(query.origins[q], query.valid[q] ? 1.0f : 0.0f);
-    nrm[i] = glm::vec4(query.normals[q], 0.0f);
-  }
+  // One batch of points and normals at a time (not a second copy of the whole query): the
+  // blocking writes wait for the previous batch's kernels, which read the same buffers.
+  std::vector<glm::vec4> pts(batch), nrm(batch);
   std::vector<float> values(n);
   std::vector<std::uint32_t> kept(n);
   const cl_int rule = static_cast<cl_int>(options.false_hit);
   for (std::size_t first = 0; first < n; first += batch) {
     const std::size_t count = std::min(batch, n - first);
     const auto count32 = static_cast<cl_uint>(count);
-    m.write(m.points.get(), count * sizeof(cl_float4), &pts[first], "query points");
-    m.write(m.normals.get(), count * sizeof(cl_float4), &nrm[first], "query normals");
+    parallel_for(count, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t q = order[first + i];
+        pts[i] = glm::vec4(query.origins[q], query.valid[q] ? 1.0f : 0.0f);
+        nrm[i] = glm::vec4(query.normals[q], 0.0f);
+      }
+    }, 1 << 16);
+    check(clEnqueueWriteBuffer(m.queue.get(), m.points.get(), CL_TRUE, 0, count * sizeof(cl_float4), pts.data(), 0,
+                               nullptr, nullptr),
+          "uploading query points");
+    check(clEnqueueWriteBuffer(m.queue.get(), m.normals.get(), CL_TRUE, 0, count * sizeof(cl_float4), nrm.data(), 0,
+                               nullptr, nullptr),
+          "uploading query normals");
     if (m.bundles) {
       // Ray r of kBundle Morton-neighbouring points per work item (cl/sdf_trace.cl).
       set_args(m.k_bundles.get(), "trace_bundles", m.cells.get(), m.tris.get(), m.points.get(),

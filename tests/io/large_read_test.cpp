@@ -5,11 +5,13 @@
 #include "sdfkit/io/field.hpp"
 
 #include "io_test_util.hpp"
+#include "readers.hpp"
 
 #include <gtest/gtest.h>
 
 #include <charconv>
 #include <cstdlib>
+#include <filesystem>
 
 namespace sdfkit {
 namespace {
@@ -110,6 +112,25 @@ TEST(LargeRead, AMeshTooLargeForMemoryIsRefusedFromItsCounts) {
                            "a mesh of 60000 vertices and 20000 triangles needs about");
   unsetenv("SDFKIT_MEMORY_LIMIT");
   EXPECT_NO_THROW(io::load_asset(obj_path));
+}
+
+// A 50M-triangle mesh (25M vertices): with 24 GiB available it is estimated to fit (about
+// 10.6 GiB); with 8 GiB a file of that size (sparse: a header, then a hole of the binary data's
+// exact length, so that it is not refused as truncated first) is refused from its header's
+// counts, before anything is allocated or read.
+TEST(LargeRead, FiftyMillionTrianglesFitIn24GiBAndAreRefusedIn8) {
+  ScratchDir dir;
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 25000000\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 50000000\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string ply = dir.write("huge.ply", header);
+  std::filesystem::resize_file(ply, header.size() + 25000000ull * 12 + 50000000ull * 13);
+  ASSERT_EQ(setenv("SDFKIT_MEMORY_LIMIT", "25769803776", 1), 0);  // 24 GiB
+  EXPECT_NO_THROW(io::detail::check_mesh_fits(ply, 25000000, 50000000));
+  ASSERT_EQ(setenv("SDFKIT_MEMORY_LIMIT", "8589934592", 1), 0);  // 8 GiB
+  test::expect_input_error([&] { io::load_asset(ply); }, ply,
+                           "a mesh of 25000000 vertices and 50000000 triangles needs about 10.6 GiB");
+  unsetenv("SDFKIT_MEMORY_LIMIT");
 }
 
 }  // namespace

@@ -137,6 +137,39 @@ TEST(DepthPeel, UpdatePositionsReusesTheSessionAndScalesValues) {
   SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(be->context());
 }
 
+// On a CPU device (lavapipe), compute() warns once, before any rasterization, when the estimated
+// time (0.3 us per triangle and camera draw and lane, every chunk drawing every camera) exceeds
+// warn_after_seconds; chunked queries warn once, not per chunk; a GPU never warns.
+TEST(DepthPeel, CpuDeviceWarnsOnceWhenTheEstimatedTimeIsLong) {
+  EXPECT_DOUBLE_EQ(estimated_cpu_seconds(1000000, 100, 1, 1), 30.0);
+  EXPECT_DOUBLE_EQ(estimated_cpu_seconds(1000000, 100, 3, 2), 45.0);
+  const Mesh m = shapes::capsule(1.0f, 4.0f, 24, 12);
+  DepthPeelConfig quiet = small_config(16, 64), warned = quiet, chunked = quiet;
+  warned.warn_after_seconds = 1e-9;
+  chunked.warn_after_seconds = 1e-9;
+  chunked.max_points_per_chunk = 100;
+  const DepthPeelConfig* configs[] = {&quiet, &warned, &chunked};
+  for (const DepthPeelConfig* cfg : configs) {
+    auto be = make_backend(*cfg);
+    if (!be) GTEST_SKIP() << "no Vulkan device";
+    be->set_mesh(m);
+    test::LogCapture capture(LogLevel::Warning);
+    compute_sdf(*be, m, SdfOptions{});
+    const auto warnings = capture.messages();
+    const bool cpu = be->context().info().type == "cpu";
+    if (!cpu || cfg == &quiet) {
+      EXPECT_TRUE(warnings.empty()) << warnings.front();
+      continue;
+    }
+    ASSERT_EQ(warnings.size(), 1u);
+    const std::size_t chunks = cfg == &chunked ? (m.positions.size() + 99) / 100 : 1;
+    EXPECT_NE(warnings[0].find(std::to_string(m.triangles.size()) + " triangles x 16 views in " +
+                               std::to_string(chunks) + " chunk"),
+              std::string::npos)
+        << warnings[0];
+  }
+}
+
 TEST(DepthPeel, PointsInChunksGiveTheSameValues) {
   // A huge mesh's sample storage does not fit one storage buffer; its points then run in chunks.
   // Forced here with a small chunk: the same values, bit for bit.

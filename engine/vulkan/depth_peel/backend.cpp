@@ -106,6 +106,7 @@ RawSdf DepthPeelBackend::compute(const SdfQuery& query, const SdfOptions& option
   if (limit == 0)
     throw DeviceError("one point's sample storage exceeds the device's storage buffer range; use fewer views or a "
                       "smaller max_samples_per_point");
+  if (!in_chunks_) warn_if_slow(n, limit);
   if (n > limit) return compute_in_chunks(query, options, limit);
   m.ensure_query_buffers(n, max_samples);
   m.upload_points(query);

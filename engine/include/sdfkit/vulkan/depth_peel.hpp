@@ -109,7 +109,17 @@ struct DepthPeelConfig {
   // the second lane's samples are appended to the first lane's per point before the gather.
   // A GPU runs one context.
   int lanes = 0;
+  // CPU devices (lavapipe): compute() warns (one line) when its estimated time exceeds this many
+  // seconds; see estimated_cpu_seconds(). 0 = never.
+  double warn_after_seconds = 60.0;
 };
+
+// The time a CPU rasterizer (lavapipe) takes at least for `triangles` x `views` camera draws in
+// `chunks` chunks of points on `lanes` lanes, in seconds: ~0.3 us of single-threaded vertex
+// processing, setup and binning per triangle and camera draw and lane (measured on the 2-core
+// EPYC CI machine, Mesa 22.3, see `mode` above), each chunk drawing every camera again. Peel
+// layers (PeelMode::Layers) and rasterization come on top: a lower bound.
+double estimated_cpu_seconds(std::size_t triangles, int views, std::size_t chunks, int lanes);
 
 // Devices as `sdfkit devices` shows them, with suitability for this backend.
 std::vector<DeviceInfo> list_devices_for_depth_peel();
@@ -152,6 +162,10 @@ private:
   // Splits a query whose per-point sample storage exceeds one storage buffer into chunks of
   // `per_chunk` points (each chunk rasterizes every camera again); timings add up.
   RawSdf compute_in_chunks(const SdfQuery& query, const SdfOptions& options, std::size_t per_chunk);
+  // On a CPU device: one warning line when estimated_cpu_seconds for `points` in chunks of
+  // `per_chunk` exceeds DepthPeelConfig::warn_after_seconds.
+  void warn_if_slow(std::size_t points, std::size_t per_chunk) const;
+  bool in_chunks_ = false;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
