@@ -20,20 +20,25 @@ layout(push_constant) uniform Push {
   uint size;   // atlas side, texels
   uint axis;   // 0: along x (rows), 1: along y (columns)
   uint box;    // which radius of the chart's cascade
+  uint src_tiled;  // 0: the source is the row-major raster copy (the first pass)
 } pc;
 
-uint g_base, g_stride;
+uvec2 g_origin;  // the line's first texel
+uvec2 g_step;    // (1, 0) along a row, (0, 1) along a column
 int g_n;
 bool g_wrap;
 
+uint src_index(uvec2 p) { return pc.src_tiled != 0u ? tiled_index(p.x, p.y, pc.size) : p.y * pc.size + p.x; }
+
+// Texel k of the line: rows of wrapping charts wrap (the radius is below the row's length, see
+// plan_blur), elsewhere zeros outside.
 vec2 fetch(int k) {
   if (g_wrap) {
-    k %= g_n;
-    if (k < 0) k += g_n;
+    k = k < 0 ? k + g_n : (k >= g_n ? k - g_n : k);
   } else if (k < 0 || k >= g_n) {
     return vec2(0.0);
   }
-  return src[g_base + uint(k) * g_stride];
+  return src[src_index(g_origin + uint(k) * g_step)];
 }
 
 void main() {
@@ -42,13 +47,13 @@ void main() {
   const uvec2 job = jobs[pc.job_offset + j];
   const Chart c = charts[job.x];
   if (pc.axis == 0u) {
-    g_base = (c.rect.y + job.y) * pc.size + c.rect.x;
-    g_stride = 1u;
+    g_origin = uvec2(c.rect.x, c.rect.y + job.y);
+    g_step = uvec2(1u, 0u);
     g_n = int(c.rect.z);
     g_wrap = c.params.w != 0u;
   } else {
-    g_base = c.rect.y * pc.size + c.rect.x + job.y;
-    g_stride = pc.size;
+    g_origin = uvec2(c.rect.x + job.y, c.rect.y);
+    g_step = uvec2(0u, 1u);
     g_n = int(c.rect.w);
     g_wrap = false;
   }
@@ -57,7 +62,8 @@ void main() {
   vec2 sum = vec2(0.0);
   for (int k = -r; k <= r; ++k) sum += fetch(k);
   for (int i = 0; i < g_n; ++i) {
-    dst[g_base + uint(i) * g_stride] = sum * norm;
+    const uvec2 p = g_origin + uint(i) * g_step;
+    dst[tiled_index(p.x, p.y, pc.size)] = sum * norm;
     sum += fetch(i + r + 1) - fetch(i - r);
   }
 }

@@ -9,7 +9,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, binding = 0) readonly buffer Charts { Chart charts[]; };
-layout(std430, binding = 1) readonly buffer Texels { vec2 texels[]; };
+layout(std430, binding = 1) readonly buffer Texels { vec2 texels[]; };  // tiled (atlas_common.glsl)
 layout(std430, binding = 2) buffer Atlas { float atlas[]; };
 
 layout(push_constant) uniform Push {
@@ -31,7 +31,7 @@ void main() {
   const bool wrap = c.params.w != 0u;
   int cx = wrap ? ((local.x % w) + w) % w : clamp(local.x, 0, w - 1);
   int cy = clamp(local.y, 0, h - 1);
-  const vec2 own = texels[(c.rect.y + uint(cy)) * pc.size + c.rect.x + uint(cx)];
+  const vec2 own = texels[tiled_index(c.rect.x + uint(cx), c.rect.y + uint(cy), pc.size)];
   if (own.y > kCovered) {
     atlas[uint(at.y) * pc.size + uint(at.x)] = own.x / own.y;
     return;
@@ -46,7 +46,7 @@ void main() {
       int x = cx + dx, y = cy + dy;
       if (wrap) x = ((x % w) + w) % w;
       if (x < 0 || y < 0 || x >= w || y >= h) continue;
-      const vec2 t = texels[(c.rect.y + uint(y)) * pc.size + c.rect.x + uint(x)];
+      const vec2 t = texels[tiled_index(c.rect.x + uint(x), c.rect.y + uint(y), pc.size)];
       if (t.y > kCovered) {
         best = d;
         value = t.x / t.y;

@@ -15,7 +15,7 @@ struct Query {
 };
 
 layout(std430, binding = 0) readonly buffer Charts { Chart charts[]; };
-layout(std430, binding = 1) readonly buffer Texels { vec2 texels[]; };
+layout(std430, binding = 1) readonly buffer Texels { vec2 texels[]; };  // tiled (atlas_common.glsl)
 layout(std430, binding = 2) readonly buffer Queries { Query queries[]; };
 layout(std430, binding = 3) writeonly buffer Values { float values[]; };
 
@@ -45,7 +45,7 @@ void main() {
       }
       y = clamp(y, 0, h - 1);
       const float wgt = (dx == 0 ? 1.0 - f.x : f.x) * (dy == 0 ? 1.0 - f.y : f.y);
-      acc += wgt * texels[(c.rect.y + uint(y)) * pc.size + c.rect.x + uint(x)];
+      acc += wgt * texels[tiled_index(c.rect.x + uint(x), c.rect.y + uint(y), pc.size)];
     }
   }
   values[i] = acc.y > 1e-6 ? acc.x / acc.y : q.fallback;

@@ -18,6 +18,7 @@ vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPa
     push.size = in.size;
     push.axis = axis;
     push.box = box;
+    push.src_tiled = step == 0 ? 0u : 1u;
     auto p = graph.add_pass(std::string("atlas.blur.") + (axis == 0 ? "x" : "y") + std::to_string(box),
                             vk::PassKind::Compute);
     p.storage_read(src);

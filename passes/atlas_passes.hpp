@@ -43,8 +43,14 @@ struct RasterPush {  // atlas_raster.vert
   glm::vec4 scale;   // x: 2 / atlas size
 };
 struct BlurPush {    // atlas_blur.comp
-  std::uint32_t job_offset, job_count, size, axis, box;
+  std::uint32_t job_offset, job_count, size, axis, box, src_tiled;
 };
+
+// Bytes of a tiled texel buffer (glsl/atlas_common.glsl: 64² tiles of vec2) of a size² atlas.
+inline std::uint64_t tiled_texel_bytes(std::uint32_t size) {
+  const std::uint64_t tiles = (size + 63u) / 64u;
+  return tiles * tiles * 64u * 64u * 8u;
+}
 struct SamplePush {  // atlas_sample.comp
   std::uint32_t vertex_count, size;
 };
@@ -63,8 +69,9 @@ struct AtlasRasterPass {
 vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& pass);
 
 // The separable box cascade: three boxes along x (rows, `row_jobs` uvec2 jobs from offset 0),
-// then three along y (`column_jobs` from offset row_jobs), ping-ponging between `texels` and
-// `scratch`. Returns the blurred texel buffer (a version of `texels`).
+// then three along y (`column_jobs` from offset row_jobs), ping-ponging between `texels` (read
+// row-major by the first pass) and `scratch`, both tiled_texel_bytes. Returns the blurred, tiled
+// texel buffer (a version of `texels`).
 struct AtlasBlurPass {
   const vk::Pipeline* pipeline = nullptr;
   vk::BufferHandle texels, scratch, charts, jobs;

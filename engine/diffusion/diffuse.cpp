@@ -102,7 +102,10 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, f
   BlurPlan plan;
   plan.dispatches = passes::kBlurDispatches;
   for (const Chart& c : mapping.charts) {
-    const auto r = box_radii(sigma_px_of(c, options, mean_edge));
+    auto r = box_radii(sigma_px_of(c, options, mean_edge));
+    // A periodic box no wider than the period (the shader wraps an index once at most).
+    if (c.wraps_x)
+      for (std::uint32_t& x : r) x = std::min(x, c.width > 1 ? (c.width - 1) / 2 : 0u);
     plan.radii.push_back(r);
     plan.line_jobs += std::uint64_t{c.width} + c.height;
     for (std::uint32_t box = 0; box < 3; ++box) {
@@ -192,7 +195,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     if (!std::isfinite(values[v])) throw InputError("vertex " + std::to_string(v) + "'s value is not finite");
   const std::uint32_t size = mapping.size;
   const std::uint32_t max_side = ctx.capabilities().max_image_dimension_2d;
-  const VkDeviceSize texel_bytes = VkDeviceSize{size} * size * sizeof(glm::vec2);
+  const VkDeviceSize texel_bytes = passes::tiled_texel_bytes(size);
   if ((max_side && size > max_side) ||
       (ctx.capabilities().max_storage_buffer_range && texel_bytes > ctx.capabilities().max_storage_buffer_range))
     throw DeviceError("a " + std::to_string(size) + "² atlas is larger than the device allows");
@@ -295,7 +298,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   bp.row_jobs = row_jobs;
   bp.column_jobs = column_jobs;
   bp.size = size;
-  const auto blurred = passes::add_atlas_blur_passes(graph, bp);
+  const auto blurred = options.blur ? passes::add_atlas_blur_passes(graph, bp) : rastered;
 
   passes::AtlasSamplePass sp;
   sp.pipeline = &impl_->sample;

@@ -43,6 +43,10 @@ struct DiffuseOptions {
   float sigma = 0.0f;      // in model units, per chart sigma · texels_per_unit. Exactly one > 0.
   bool keep_atlas = false; // also return the dilated, normalized atlas (DiffuseResult::atlas)
   bool profile = false;    // per-pass device times (DiffuseResult::timings)
+  // false: the graph without the blur passes (raster, sample): the benchmark's baseline, so the
+  // blur's cost is the difference of two wall times (lavapipe's per-pass timestamps are not
+  // reliable: it bins draws and rasterizes them later). The values are then meaningless.
+  bool blur = true;
 };
 
 // Where the time went (milliseconds). Device times only with DiffuseOptions::profile.
