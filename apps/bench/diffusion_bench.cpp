@@ -3,12 +3,7 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/diffusion/diffuse.hpp"
-#if __has_include("sdfkit/diffusion/stm.hpp")
 #include "sdfkit/diffusion/stm.hpp"
-#define SDFKIT_BENCH_HAS_STM 1
-#else
-#define SDFKIT_BENCH_HAS_STM 0
-#endif
 #include "sdfkit/post/smooth.hpp"
 #include "sdfkit/skeleton/skeleton.hpp"
 #include "sdfkit/vulkan/context.hpp"
@@ -129,7 +124,6 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
     if (bm.mapping) {
       mapping = *bm.mapping;
     } else {
-#if SDFKIT_BENCH_HAS_STM
       const Mesh& skel_mesh = bm.base ? *bm.base : bm.mesh;
       const skeleton::Skeleton skel = skeleton::extract(skel_mesh, nullptr, {}, {});
       skeleton_s = ms_since(t) / 1000.0;
@@ -140,10 +134,6 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
       mapping_ms = ms_since(t);
       jm["atlas_used"] = stm.quality.atlas_used;
       mapping = std::move(mapping);
-#else
-      std::fprintf(stderr, "  skipped: the skeleton texture mapping is not built in\n");
-      continue;
-#endif
     }
     jm["skeleton_seconds"] = skeleton_s;
     jm["mapping_ms"] = mapping_ms;
