@@ -8,6 +8,10 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/diffusion/diffuse.hpp"
+#include "sdfkit/diffusion/stm.hpp"
+#include "sdfkit/io/asset.hpp"
+#include "sdfkit/skeleton/skeleton.hpp"
+#include "analytic.hpp"
 #include "sdfkit/post/compare.hpp"
 #include "sdfkit/post/smooth.hpp"
 
@@ -256,6 +260,52 @@ TEST_F(Diffuse, NoSeamsAcrossChartBorders) {
     EXPECT_LE(ratio, 1.5) << edges << " edges";
     const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
     EXPECT_GE(compare_fields(tex, heat).pearson, 0.95) << edges << " edges";
+  }
+}
+
+}  // namespace
+}  // namespace sdfkit::diffusion
+
+namespace sdfkit::diffusion {
+namespace {
+
+// A real mesh through the real mapping: CGAL's camel, its skeleton extracted from the geometry
+// (no SDF backend) and build_stm's atlas (210 charts). Against heat diffusion at 1..5 mean edges:
+// Pearson >= 0.95 and median relative difference <= 5 % hold (measured 0.995..0.999 and
+// 0.4..1.4 %). What does not hold yet, printed and not asserted: the RMS difference is 1.1..1.8x
+// k-ring's, and the seam ratio (P95 jump across chart borders / inside charts) is 4..21, because
+// build_stm's charts carry only one ring of their neighbours' triangles, and a chart never sees
+// another's texels: seamless diffusion needs charts that overlap by about 3 sigma (as the split
+// cylinder of NoSeamsAcrossChartBorders does).
+TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
+  const Mesh m = io::load_asset(test::data_mesh("camel.off")).mesh;
+  const Stm stm = build_stm(m, skeleton::extract(m, nullptr, {}, {}));
+  const AtlasMapping& a = stm.mapping;
+  const Aabb box = bounding_box(m.positions);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.05f);
+  std::vector<float> u(m.vertex_count());
+  for (std::size_t v = 0; v < u.size(); ++v) {
+    const glm::vec3 p = (m.positions[v] - box.min) / box.diagonal();
+    u[v] = 1.0f + 0.5f * std::sin(6.0f * p.x) * std::cos(5.0f * p.y) + noise(rng);
+  }
+  const float edge = mean_edge_length(m);
+  for (float edges : {1.0f, 2.0f, 3.0f, 5.0f}) {
+    const float sigma = edges * edge;
+    const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
+    const std::vector<float> tex = diffuser_->run(m, a, u, sigma_of(sigma)).values;
+    SmoothOptions so;
+    so.sigma = sigma;
+    so.rings = kring_for_sigma(sigma, edge);
+    const std::vector<float> kring = smooth_field(m, SdfDomain::Vertex, u, so);
+    const Agreement t = agreement(tex, heat), k = agreement(kring, heat);
+    const test::SeamJumps s = test::seam_jumps(m, a, tex);
+    const double ratio = test::quantile(s.border, 0.95) / test::quantile(s.inside, 0.95);
+    EXPECT_GE(t.pearson, 0.95) << edges << " edges";
+    EXPECT_LE(t.median_rel, 0.05) << edges << " edges";
+    std::printf("camel sigma %.0f edges (%zu charts): texture pearson %.4f median %.4f rms %.4f seam ratio %.2f | "
+                "k-ring (k=%d) pearson %.4f median %.4f rms %.4f\n",
+                edges, a.charts.size(), t.pearson, t.median_rel, t.rms, ratio, so.rings, k.pearson, k.median_rel, k.rms);
   }
 }
 
