@@ -133,7 +133,7 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
       diffusion::Stm stm = diffusion::build_stm(bm.mesh, skel, so);
       mapping_ms = ms_since(t);
       jm["atlas_used"] = stm.quality.atlas_used;
-      mapping = std::move(mapping);
+      mapping = std::move(stm.mapping);
     }
     jm["skeleton_seconds"] = skeleton_s;
     jm["mapping_ms"] = mapping_ms;
