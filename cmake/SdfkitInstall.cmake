@@ -13,7 +13,7 @@ include(CMakePackageConfigHelpers)
 target_compile_features(sdfkit_core PUBLIC cxx_std_20)
 
 set(_sdfkit_export_targets sdfkit_core sdfkit_io sdfkit_post sdfkit)
-foreach(_t sdfkit_opencl sdfkit_vulkan sdfkit_render sdfkit_passes sdfkit_skeleton sdfkit_pointcloud sdfkit_vulkan_shaders sdfkit_opencl_kernels)
+foreach(_t sdfkit_opencl sdfkit_vulkan sdfkit_render sdfkit_diffuse sdfkit_passes sdfkit_skeleton sdfkit_pointcloud sdfkit_diffusion sdfkit_vulkan_shaders sdfkit_opencl_kernels)
   if(TARGET ${_t})
     get_target_property(_type ${_t} TYPE)
     if(NOT _type STREQUAL "UTILITY")

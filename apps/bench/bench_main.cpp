@@ -3,6 +3,7 @@
 // meshes in one run; writes Markdown and JSON.
 #include "batch_bench.hpp"
 #include "bench_runner.hpp"
+#include "diffusion_bench.hpp"
 #include "huge_bench.hpp"
 
 #include "sdfkit/io/asset.hpp"
@@ -63,6 +64,13 @@ int main(int argc, char** argv) {
   app.add_flag("--huge", huge,
                "Instead of the table: CGAL's armadillo subdivided to levels 3 and 4 (3.3M, 13.3M triangles) as binary "
                "PLY and OBJ, each through `sdfkit compute --json` in its own process: time and peak memory per stage");
+  bool diffusion = false;  // issue 13
+  DiffusionBenchOptions diffusion_options;
+  app.add_flag("--diffusion", diffusion,
+               "Table 2: texture-space diffusion at radius 2..64 px on a 2048² atlas and k-ring k = 1..6 "
+               "(a full-atlas cylinder of ~500k vertices, CGAL's elephant, armadillo, bunny00 and armadillo subdivided twice)");
+  app.add_option("--radii", diffusion_options.radii, "--diffusion: blur radii in texels")->delimiter(',')->check(CLI::PositiveNumber);
+  app.add_option("--atlas-size", diffusion_options.atlas_size, "--diffusion: atlas side in texels")->check(CLI::Range(16, 16384));
   app.add_option("--huge-levels", huge_options.levels, "--huge: subdivision levels")->delimiter(',')->check(CLI::Range(0, 6));
   app.add_option("--huge-formats", huge_options.formats, "--huge: ply, obj")->delimiter(',');
   app.add_option("--huge-backend", huge_options.backend, "--huge: the backend of the runs");
@@ -94,13 +102,8 @@ int main(int argc, char** argv) {
 
   try {
     fs::create_directories(work);
-    if (app.count("--batch") > 0) {
-      batch_options.work_dir = work;
-      batch_options.rays = o.rays;
-      batch_options.sdfkit = self_dir() + "/sdfkit";
-      if (!fs::exists(batch_options.sdfkit)) batch_options.sdfkit = self_dir() + "/../sdfkit";
-      std::string table;
-      auto j = run_batch_bench(batch_options, table);
+    // The special modes print a Markdown table and write it and their JSON where asked.
+    const auto emit = [&](const std::string& table, nlohmann::json& j) {
       const std::string md = "Machine: " + cpu_name() + ", " + std::to_string(std::thread::hardware_concurrency()) +
                              " hardware threads.\n\n" + table;
       std::printf("%s", md.c_str());
@@ -110,6 +113,38 @@ int main(int argc, char** argv) {
         sdfkit::io::write_file_atomically(json_out, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
       }
       return 0;
+    };
+    if (app.count("--batch") > 0) {
+      batch_options.work_dir = work;
+      batch_options.rays = o.rays;
+      batch_options.sdfkit = self_dir() + "/sdfkit";
+      if (!fs::exists(batch_options.sdfkit)) batch_options.sdfkit = self_dir() + "/../sdfkit";
+      std::string table;
+      auto j = run_batch_bench(batch_options, table);
+      return emit(table, j);
+    }
+    if (diffusion) {
+      diffusion_options.repeats = std::max(o.repeats, 1);
+      diffusion_options.device = o.device;
+      std::vector<DiffusionMesh> dm;
+      dm.push_back(cylinder_mesh(1000, 499, diffusion_options.atlas_size));
+      if (meshes.empty()) {
+        for (BenchMesh& m : default_meshes(work, false))
+          if (m.name != "refined_elephant") dm.push_back({m.name, std::move(m.mesh), {}, {}});
+        DiffusionMesh big;
+        big.name = "armadillo-subdiv2";
+        big.base = dm[2].mesh;
+        big.mesh = sdfkit::subdivide_midpoint(sdfkit::subdivide_midpoint(dm[2].mesh));
+        dm.push_back(std::move(big));
+      } else {
+        for (const auto& path : meshes) {
+          BenchMesh m = load_mesh(path, work);
+          dm.push_back({m.name, std::move(m.mesh), {}, {}});
+        }
+      }
+      std::string table;
+      auto j = run_diffusion_bench(dm, diffusion_options, table);
+      return emit(table, j);
     }
     if (huge) {
       huge_options.work_dir = work;
@@ -122,15 +157,7 @@ int main(int argc, char** argv) {
       }
       std::string table;
       auto j = run_huge(huge_options, table);
-      const std::string md = "Machine: " + cpu_name() + ", " + std::to_string(std::thread::hardware_concurrency()) +
-                             " hardware threads.\n\n" + table;
-      std::printf("%s", md.c_str());
-      if (!md_out.empty()) sdfkit::io::write_file_atomically(md_out, [&](std::ostream& os) { os << md; });
-      if (!json_out.empty()) {
-        j["machine"] = cpu_name();
-        sdfkit::io::write_file_atomically(json_out, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
-      }
-      return 0;
+      return emit(table, j);
     }
     std::vector<BenchMesh> list;
     if (meshes.empty())

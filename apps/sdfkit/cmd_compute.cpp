@@ -42,6 +42,11 @@ void add_output_options(CLI::App& cmd, SdfCliOptions& o, bool smoothing) {
   if (smoothing)
     cmd.add_option("--smooth", o.smooth, "k-ring Gaussian smoothing of the result (rings, 0 = off)")
         ->check(CLI::Range(0, 64));
+  if (smoothing)
+    cmd.add_option("--smooth-texture", o.smooth_texture,
+                   "Texture-space diffusion of the result: Gaussian sigma in texels of a 2048² skeleton texture "
+                   "mapping (0 = off; per-vertex results, Vulkan)")
+        ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--normalize", o.write.normalized, "Write values normalised to [0, 1]");
   cmd.add_flag("--no-color", o.no_color, "Do not write COLOR_0 / PLY colours");
 }
@@ -60,6 +65,7 @@ ComputeRequest SdfCliOptions::request() const {
   r.sdf = sdf;
   r.write = write;
   r.smooth_rings = smooth;
+  r.smooth_texture_px = smooth_texture;
   r.backend = backend_config;
   return r;
 }

@@ -1,10 +1,14 @@
-// sdfkit smooth: k-ring Gaussian smoothing of a result file, written like compute's output.
+// sdfkit smooth: k-ring Gaussian smoothing of a result file, written like compute's output, or
+// (--texture-space) diffusion through a skeleton texture mapping on a Vulkan device (issue 13).
 // Also the result loading shared by render and compare.
 #include "commands.hpp"
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/io/field.hpp"
 #include "sdfkit/post/smooth.hpp"
+#ifdef SDFKIT_CLI_HAS_RENDER
+#include "sdfkit/diffusion/diffuse_mesh.hpp"
+#endif
 
 #include <algorithm>
 #include <cctype>
@@ -62,10 +66,14 @@ ResultValues load_or_compute(const std::string& input, const SdfCliOptions* sdf,
 }
 
 void add_smooth_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("smooth", "k-ring Gaussian smoothing of a result file");
+  auto* cmd = app.add_subcommand("smooth", "k-ring Gaussian smoothing of a result file, or texture-space diffusion (--texture-space)");
   struct Args {
     std::string input, output;
     SmoothOptions smooth;
+    bool texture = false;
+    float radius = 0.0f;
+    std::uint32_t atlas_size = 2048;
+    std::string atlas_png, skeleton, device;
     io::LoadOptions load;
     io::WriteOptions write;
     bool no_color = false, quiet = false;
@@ -76,8 +84,20 @@ void add_smooth_command(CLI::App& app) {
   cmd->add_option("--rings,-k", a->smooth.rings, "Rings K: each point averages its neighbours up to K edges away")
       ->check(CLI::Range(1, 64));
   cmd->add_option("--sigma", a->smooth.sigma,
-                  "Gaussian sigma in model units (default: K * mean edge length / 2)")
+                  "Gaussian sigma in model units (default: K * mean edge length / 2; with --texture-space, "
+                  "converted per chart by its scale)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--texture-space", a->texture,
+                "Diffuse through a skeleton texture mapping on a Vulkan device instead (needs --radius or --sigma)");
+  cmd->add_option("--radius", a->radius, "--texture-space: the Gaussian's sigma in atlas texels, every chart")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--atlas-size", a->atlas_size, "--texture-space: atlas side in texels (default 2048)")
+      ->check(CLI::Range(16, 16384));
+  cmd->add_option("--atlas-png", a->atlas_png, "--texture-space: also write the diffused field in the atlas as PNG");
+  cmd->add_option("--skeleton", a->skeleton,
+                  "--texture-space: skeleton JSON written by `sdfkit skeleton` for this mesh (default: extracted "
+                  "from the geometry)");
+  cmd->add_option("--device", a->device, "--texture-space: Vulkan device (index or name)");
   cmd->add_option("--threads", a->smooth.threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   cmd->add_flag("--normalize", a->write.normalized, "Write values normalised to [0, 1]");
   cmd->add_flag("--no-color", a->no_color, "Do not write COLOR_0 / PLY colours");
@@ -85,9 +105,58 @@ void add_smooth_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   add_asset_options(*cmd, a->load);
   cmd->add_flag("-q,--quiet", a->quiet, "Print nothing on success");
-  cmd->callback([a] {
+  cmd->callback([a, cmd] {
     a->write.color = !a->no_color;
+    const auto given = [cmd](const char* name) { return cmd->get_option(name)->count() > 0; };
+    if (a->texture) {
+      for (const char* k : {"--rings", "--threads"})
+        if (given(k)) throw UsageError(std::string(k) + " is k-ring smoothing's; --texture-space takes --radius or --sigma");
+      if (given("--radius") == given("--sigma"))
+        throw UsageError("--texture-space needs exactly one of --radius (texels) and --sigma (model units)");
+      if (!a->atlas_png.empty()) check_png_name(a->atlas_png);
+    } else {
+      for (const char* k : {"--radius", "--atlas-size", "--atlas-png", "--skeleton", "--device"})
+        if (given(k)) throw UsageError(std::string(k) + " needs --texture-space");
+    }
     const ResultValues r = load_or_compute(a->input, nullptr, a->load);
+    if (a->texture) {
+#ifdef SDFKIT_CLI_HAS_RENDER
+      if (r.domain != SdfDomain::Vertex)
+        throw InputError(a->input + ": texture-space diffusion needs per-vertex values (this result is per face)");
+      diffusion::TextureSmoothOptions t;
+      t.diffuse.radius_px = a->radius;
+      t.diffuse.sigma = a->radius > 0.0f ? 0.0f : a->smooth.sigma;
+      t.stm.atlas_size = a->atlas_size;
+      t.device = a->device;
+      skeleton::Skeleton skel;
+      if (!a->skeleton.empty()) {
+        skel = diffusion::read_skeleton_json(a->skeleton);
+        t.skeleton = &skel;
+      }
+      const auto start = std::chrono::steady_clock::now();
+      const diffusion::TextureSmoothResult d = diffusion::smooth_texture_space(r.asset.mesh, r.values, t);
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      SdfField field;
+      field.domain = r.domain;
+      field.values = d.values;
+      field.kept_rays.assign(field.values.size(), 0);
+      field.filled.assign(field.values.size(), 0);
+      if (!a->atlas_png.empty()) diffusion::write_atlas_png(d.stm.mapping, r.asset.mesh, d.values, a->atlas_png);
+      io::write_field(a->output, r.asset, field, a->write);
+      char scale[64];
+      if (a->radius > 0.0f) std::snprintf(scale, sizeof scale, "radius %g px", static_cast<double>(a->radius));
+      else std::snprintf(scale, sizeof scale, "sigma %g", static_cast<double>(a->smooth.sigma));
+      if (!a->quiet)
+        std::printf("%s: %zu vertex values diffused in texture space (%zu charts on a %u² atlas, %s) in %.1f ms "
+                    "(skeleton %.2f s, mapping %.2f s, diffusion %.1f ms) -> %s\n",
+                    a->input.c_str(), field.values.size(), d.stm.mapping.charts.size(), d.stm.mapping.size,
+                    scale,
+                    ms, d.skeleton_seconds, d.mapping_seconds, d.diffusion.timings.total, a->output.c_str());
+      return;
+#else
+      throw UsageError("--texture-space needs the Vulkan engine (built with SDFKIT_WITH_VULKAN=OFF)");
+#endif
+    }
     const auto start = std::chrono::steady_clock::now();
     SdfField field;
     field.domain = r.domain;

@@ -34,6 +34,7 @@ struct SdfCliOptions {
   io::WriteOptions write;
   bool no_color = false;
   int smooth = 0;
+  float smooth_texture = 0.0f;  // --smooth-texture R (issue 13)
   // Every option above as the pipeline's request (input and output empty).
   ComputeRequest request() const;
 };

@@ -28,7 +28,7 @@ static_assert(member_count<SdfOptions>() == 4, "SdfOptions: options_to_json must
 static_assert(member_count<BackendConfig>() == 10, "BackendConfig: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<io::LoadOptions>() == 4, "io::LoadOptions: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<io::WriteOptions>() == 3, "io::WriteOptions: options_to_json must write every member (the batch fingerprint is made of it)");
-static_assert(member_count<ComputeRequest>() == 7, "ComputeRequest: options_to_json must write every member (the batch fingerprint is made of it)");
+static_assert(member_count<ComputeRequest>() == 8, "ComputeRequest: options_to_json must write every member (the batch fingerprint is made of it)");
 
 // FNV-1a over the overlays' bytes: they are data, not settings, and may be large.
 std::string overlay_digest(const io::Overlay& o) {
@@ -45,7 +45,7 @@ std::string overlay_digest(const io::Overlay& o) {
   return buf;
 }
 
-nlohmann::json options_object(const ComputeRequest& r) {
+nlohmann::json options_object_base(const ComputeRequest& r) {
   const BackendConfig& b = r.backend;
   nlohmann::json order = nlohmann::json::array();
   for (BackendKind k : b.auto_order) order.push_back(to_string(k));
@@ -80,6 +80,14 @@ nlohmann::json options_object(const ComputeRequest& r) {
         {"max_file_size", r.load.max_file_size}}},
       {"write", {{"color", r.write.color}, {"normalized", r.write.normalized}, {"overlays", overlays}}},
       {"smooth_rings", r.smooth_rings}};
+}
+
+// With texture-space smoothing (issue 13) its radius too; absent when off, so the fingerprints of
+// requests without it are what they were.
+nlohmann::json options_object(const ComputeRequest& r) {
+  nlohmann::json j = options_object_base(r);
+  if (r.smooth_texture_px > 0.0f) j["smooth_texture_px"] = r.smooth_texture_px;
+  return j;
 }
 
 }  // namespace

@@ -5,6 +5,9 @@
 #include "sdfkit/core/weld.hpp"
 #include "sdfkit/io/solids.hpp"
 #include "sdfkit/post/smooth.hpp"
+#ifdef SDFKIT_HAS_VULKAN
+#include "sdfkit/diffusion/diffuse_mesh.hpp"
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -147,6 +150,15 @@ void validate(const ComputeRequest& r) {
   validate_options(r.sdf);
   if (r.smooth_rings < 0 || r.smooth_rings > 64)
     throw UsageError("--smooth must be between 0 and 64 rings, got " + std::to_string(r.smooth_rings));
+  if (!(r.smooth_texture_px >= 0.0f) || !std::isfinite(r.smooth_texture_px) || r.smooth_texture_px > 1024.0f)
+    throw UsageError("--smooth-texture must be a radius between 0 and 1024 texels");
+  if (r.smooth_texture_px > 0.0f) {
+#ifndef SDFKIT_HAS_VULKAN
+    throw UsageError("--smooth-texture needs the Vulkan engine (this build has none)");
+#endif
+    if (r.smooth_rings > 0) throw UsageError("--smooth (k-ring) and --smooth-texture exclude each other");
+    if (r.sdf.domain == SdfDomain::Face) throw UsageError("--smooth-texture needs per-vertex values (--per vertex)");
+  }
   // io::LoadOptions::kDefaultWeld stands for the default tolerance (1e-6 of the bounding box).
   if (r.load.weld_tolerance != io::LoadOptions::kDefaultWeld &&
       (!(r.load.weld_tolerance >= 0.0f) || !std::isfinite(r.load.weld_tolerance)))
@@ -230,6 +242,16 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
     report.stages.push_back({"smooth", clock.lap_ms()});
     sample("smooth");
   }
+#ifdef SDFKIT_HAS_VULKAN
+  if (request.smooth_texture_px > 0.0f) {
+    diffusion::TextureSmoothOptions t;
+    t.diffuse.radius_px = request.smooth_texture_px;
+    t.device = request.backend.device;
+    field.values = diffusion::smooth_texture_space(asset.mesh, field.values, t).values;
+    report.stages.push_back({"smooth_texture", clock.lap_ms()});
+    sample("smooth_texture");
+  }
+#endif
   report.summary = summarize(field.values);
   return out;
 }

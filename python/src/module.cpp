@@ -12,6 +12,9 @@
 #include "sdfkit/pipeline.hpp"
 #include "sdfkit/post/compare.hpp"
 #include "sdfkit/post/smooth.hpp"
+#ifdef SDFKIT_PYTHON_HAS_DIFFUSE
+#include "sdfkit/diffusion/diffuse_mesh.hpp"
+#endif
 
 #include <pybind11/stl.h>
 
@@ -348,6 +351,34 @@ color   write colours (glTF COLOR_0, PLY rgb); weld_tolerance, allow_external_pa
       R"doc(k-ring Gaussian smoothing of a per-vertex (per="vertex", (V,)) or per-face ((F,)) field:
 each point becomes the mean of the points up to `rings` edges away, weighted by
 exp(-d^2 / (2 sigma^2)); sigma = rings * mean edge length / 2 when 0. Returns float32.)doc");
+
+#ifdef SDFKIT_PYTHON_HAS_DIFFUSE
+  // Issue 13: texture-space diffusion through a skeleton texture mapping.
+  m.def(
+      "diffuse",
+      [](const py::handle& vertices, const py::handle& faces, const py::handle& values, float radius, float sigma,
+         std::uint32_t atlas_size, const std::string& device) {
+        const Mesh mesh = to_mesh(vertices, faces, "diffuse");
+        const std::vector<float> v = to_values(values, "values");
+        diffusion::TextureSmoothOptions options;
+        options.diffuse.radius_px = radius;
+        options.diffuse.sigma = sigma;
+        options.stm.atlas_size = atlas_size;
+        options.device = device;
+        std::vector<float> out;
+        {
+          py::gil_scoped_release unlocked;
+          out = diffusion::smooth_texture_space(mesh, v, options).values;
+        }
+        return to_numpy(std::move(out));
+      },
+      "vertices"_a, "faces"_a, "values"_a, py::kw_only(), "radius"_a = 0.0f, "sigma"_a = 0.0f,
+      "atlas_size"_a = 2048u, "device"_a = "",
+      R"doc(Texture-space diffusion of a per-vertex field (V,) (the paper's section 4.1): the mesh's
+skeleton (from its geometry), a skeleton texture mapping into an atlas_size^2 atlas, and a
+Gaussian blur there on a Vulkan device, read back per vertex. Exactly one of radius (the
+Gaussian's sigma in atlas texels) and sigma (model units) > 0. Returns float32.)doc");
+#endif
 
   m.def(
       "compare",

@@ -566,6 +566,20 @@ class RoadTest(unittest.TestCase):
 class UtilityTest(unittest.TestCase):
     """smooth, compare, devices, version."""
 
+    @unittest.skipUnless(hasattr(sdfkit, "diffuse"), "built without Vulkan")
+    def test_diffuse(self):
+        v, f = capsule(0.5, 1.0)
+        constant = np.full(len(v), 3.25)
+        np.testing.assert_allclose(sdfkit.diffuse(v, f, constant, radius=4.0, atlas_size=512), constant, rtol=1e-4)
+        noisy = 1.0 + 0.2 * np.random.default_rng(7).standard_normal(len(v))
+        diffused = sdfkit.diffuse(v, f, noisy, sigma=0.1, atlas_size=512)
+        self.assertEqual(diffused.dtype, np.float32)
+        self.assertLess(float(np.std(diffused)), 0.5 * float(np.std(noisy)))
+        with self.assertRaisesRegex(sdfkit.InputError, "exactly one"):
+            sdfkit.diffuse(v, f, noisy)
+        with self.assertRaisesRegex(sdfkit.InputError, "one value per vertex"):
+            sdfkit.diffuse(v, f, noisy[:-1], radius=2.0)
+
     def test_smooth(self):
         v, f = icosphere(1.0, 2)
         constant = np.full(len(v), 3.25)

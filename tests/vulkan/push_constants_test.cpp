@@ -2,6 +2,7 @@
 // passes/figure_passes.hpp) against the GLSL blocks they feed, read back from the embedded
 // SPIR-V: same member offsets, same size. No device needed.
 #include "depth_peel_passes.hpp"
+#include "atlas_passes.hpp"
 #include "figure_passes.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -72,6 +73,21 @@ TEST(PushConstants, FigureStructsMatchTheirGlslBlocks) {
   const Expected sheet{{SDFKIT_OFF(SheetPush, view_projection), SDFKIT_OFF(SheetPush, color)}, sizeof(SheetPush)};
   expect_block("figure_sheet.vert", sheet);
   expect_block("figure_sheet.frag", sheet);
+}
+
+TEST(PushConstants, AtlasStructsMatchTheirGlslBlocks) {
+  using namespace diffusion::passes;
+  expect_block("atlas_raster.vert", {{SDFKIT_OFF(RasterPush, scale)}, sizeof(RasterPush)});
+  expect_block("atlas_blur.comp",
+               {{SDFKIT_OFF(BlurPush, job_offset), SDFKIT_OFF(BlurPush, job_count), SDFKIT_OFF(BlurPush, size),
+                 SDFKIT_OFF(BlurPush, axis), SDFKIT_OFF(BlurPush, box), SDFKIT_OFF(BlurPush, src_tiled)},
+                sizeof(BlurPush)});
+  expect_block("atlas_sample.comp",
+               {{SDFKIT_OFF(SamplePush, vertex_count), SDFKIT_OFF(SamplePush, size)}, sizeof(SamplePush)});
+  expect_block("atlas_dilate.comp",
+               {{SDFKIT_OFF(DilatePush, chart), SDFKIT_OFF(DilatePush, size), SDFKIT_OFF(DilatePush, reach),
+                 SDFKIT_OFF(DilatePush, margin)},
+                sizeof(DilatePush)});
 }
 
 TEST(PushConstants, ShadersWithoutABlockHaveNoneAndJunkIsRefused) {

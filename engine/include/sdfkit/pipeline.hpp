@@ -27,6 +27,9 @@ struct ComputeRequest {
   SdfOptions sdf;
   io::WriteOptions write;
   int smooth_rings = 0;             // k-ring Gaussian smoothing of the result, 0 = off
+  // Texture-space diffusion of the result (issue 13): the Gaussian's sigma in texels of a 2048²
+  // skeleton texture mapping, 0 = off. Per-vertex results only; not with smooth_rings.
+  float smooth_texture_px = 0.0f;
   BackendConfig backend;            // the session run_compute opens when it is not given one
 };
 

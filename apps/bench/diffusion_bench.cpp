@@ -1,0 +1,192 @@
+// sdfkit bench --diffusion (diffusion_bench.hpp).
+#include "diffusion_bench.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/diffusion/diffuse.hpp"
+#include "sdfkit/diffusion/stm.hpp"
+#include "sdfkit/post/smooth.hpp"
+#include "sdfkit/skeleton/skeleton.hpp"
+#include "sdfkit/vulkan/context.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <cstdio>
+#include <sstream>
+
+namespace sdfkit::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// A per-vertex field to diffuse: distance to the centroid (timings do not depend on the values).
+std::vector<float> bench_field(const Mesh& m) {
+  glm::vec3 c(0.0f);
+  for (const glm::vec3& p : m.positions) c += p;
+  c /= static_cast<float>(std::max<std::size_t>(m.positions.size(), 1));
+  std::vector<float> u(m.positions.size());
+  for (std::size_t v = 0; v < u.size(); ++v) u[v] = glm::length(m.positions[v] - c);
+  return u;
+}
+
+}  // namespace
+
+DiffusionMesh cylinder_mesh(int segments, int stacks, std::uint32_t size) {
+  DiffusionMesh d;
+  d.name = "cylinder-" + std::to_string(segments) + "x" + std::to_string(stacks + 1);
+  const float r = 1.0f, h = 2.0f * std::numbers::pi_v<float>;
+  Mesh& m = d.mesh;
+  for (int j = 0; j <= stacks; ++j)
+    for (int i = 0; i < segments; ++i) {
+      const float a = 2.0f * std::numbers::pi_v<float> * static_cast<float>(i) / static_cast<float>(segments);
+      m.positions.emplace_back(r * std::cos(a), r * std::sin(a), h * static_cast<float>(j) / static_cast<float>(stacks));
+    }
+  const auto id = [segments](int i, int j) { return static_cast<std::uint32_t>(j * segments + (i % segments)); };
+  for (int j = 0; j < stacks; ++j)
+    for (int i = 0; i < segments; ++i) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  diffusion::AtlasMapping a;
+  a.size = size;
+  const std::uint32_t side = size - 2 * a.gutter;
+  diffusion::Chart c;
+  c.x0 = c.y0 = a.gutter;
+  c.width = c.height = side;
+  c.wraps_x = true;
+  c.texels_per_unit = static_cast<float>(side) / h;
+  a.charts.push_back(c);
+  const auto uv = [&](std::uint32_t v) {
+    const int i = static_cast<int>(v) % segments, j = static_cast<int>(v) / segments;
+    return glm::vec2(static_cast<float>(c.x0) + static_cast<float>(side) * static_cast<float>(i) / static_cast<float>(segments),
+                     static_cast<float>(c.y0) + 0.5f + (static_cast<float>(side) - 1.0f) * static_cast<float>(j) / static_cast<float>(stacks));
+  };
+  for (std::uint32_t f = 0; f < m.face_count(); ++f) {
+    diffusion::AtlasTriangle t;
+    t.face = f;
+    for (int k = 0; k < 3; ++k) t.uv[k] = uv(m.triangles[f][static_cast<std::size_t>(k)]);
+    a.triangles.push_back(t);
+  }
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+    a.vertex_chart.push_back(0);
+    a.vertex_uv.push_back(uv(v));
+  }
+  d.mapping = std::move(a);
+  return d;
+}
+
+nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, const DiffusionBenchOptions& o,
+                                   std::string& markdown) {
+  vk::ContextConfig config;
+  config.device = o.device;
+  vk::Context ctx(config);
+  diffusion::Diffuser diffuser(ctx);
+  nlohmann::json out;
+  out["device"] = ctx.info().name;
+  out["atlas_size"] = o.atlas_size;
+  std::ostringstream md;
+  md << "Texture-space diffusion (Table 2) on " << ctx.info().name << " (" << ctx.info().driver << "), atlas "
+     << o.atlas_size << "², median of " << o.repeats << " warm runs. prepare: host (triangle soup, jobs, queries "
+     << "into upload memory); raster+sample: the graph without the blur passes (raster, copy, sample), wall time; "
+     << "blur: the full graph's wall time minus that; read-back: values out of mapped memory; total: diffuse() "
+     << "end to end (prepare + graph + read-back).\n\n";
+  md << "| mesh | vertices | skeleton s | mapping ms | radius px | prepare ms | raster+sample ms | blur ms | read-back ms | total ms |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  std::ostringstream kmd;
+  kmd << "\nk-ring smoothing on the same meshes (engine/post/smooth, all cores):\n\n| mesh | vertices |";
+  for (int k : o.rings) kmd << " k=" << k << " ms |";
+  kmd << "\n|---|---:|";
+  for (std::size_t i = 0; i < o.rings.size(); ++i) kmd << "---:|";
+  kmd << "\n";
+
+  for (const DiffusionMesh& bm : meshes) {
+    std::fprintf(stderr, "sdfkit-bench --diffusion: %s (%zu vertices)\n", bm.name.c_str(), bm.mesh.vertex_count());
+    nlohmann::json jm;
+    jm["mesh"] = bm.name;
+    jm["vertices"] = bm.mesh.vertex_count();
+    jm["faces"] = bm.mesh.face_count();
+    // The skeleton (no SDF backend: geometry only) of the mesh, or of its base mesh when it is a
+    // midpoint subdivision (the base vertices keep their indices; build_stm gives the new ones a
+    // neighbour's node).
+    auto t = Clock::now();
+    double skeleton_s = 0.0, mapping_ms = 0.0;
+    diffusion::AtlasMapping mapping;
+    if (bm.mapping) {
+      mapping = *bm.mapping;
+    } else {
+      const Mesh& skel_mesh = bm.base ? *bm.base : bm.mesh;
+      const skeleton::Skeleton skel = skeleton::extract(skel_mesh, nullptr, {}, {});
+      skeleton_s = ms_since(t) / 1000.0;
+      diffusion::StmOptions so;
+      so.atlas_size = o.atlas_size;
+      t = Clock::now();
+      diffusion::Stm stm = diffusion::build_stm(bm.mesh, skel, so);
+      mapping_ms = ms_since(t);
+      jm["atlas_used"] = stm.quality.atlas_used;
+      mapping = std::move(stm.mapping);
+    }
+    jm["skeleton_seconds"] = skeleton_s;
+    jm["mapping_ms"] = mapping_ms;
+    jm["charts"] = mapping.charts.size();
+
+    const std::vector<float> u = bench_field(bm.mesh);
+    for (float radius : o.radii) {
+      diffusion::DiffuseOptions d;
+      d.radius_px = radius;
+      diffuser.run(bm.mesh, mapping, u, d);  // warm-up
+      std::vector<double> raster, blur, sample, readback, total, unblurred;
+      diffusion::DiffuseOptions nb = d;
+      nb.blur = false;
+      for (int r = 0; r < o.repeats; ++r) {
+        unblurred.push_back(diffuser.run(bm.mesh, mapping, u, nb).timings.execute);
+        const diffusion::DiffuseResult res = diffuser.run(bm.mesh, mapping, u, d);
+        raster.push_back(unblurred.back());
+        blur.push_back(res.timings.execute - unblurred.back());
+        sample.push_back(res.timings.prepare);
+        readback.push_back(res.timings.readback);
+        total.push_back(res.timings.total);
+      }
+      nlohmann::json jr;
+      jr["radius_px"] = radius;
+      jr["prepare_ms"] = median(sample);
+      jr["raster_sample_ms"] = median(raster);
+      jr["blur_ms"] = median(blur);
+      jr["readback_ms"] = median(readback);
+      jr["total_ms"] = median(total);
+      jm["radii"].push_back(jr);
+      char line[512];
+      std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f |\n",
+                    bm.name.c_str(), bm.mesh.vertex_count(), skeleton_s, mapping_ms, static_cast<double>(radius),
+                    median(sample), median(raster), median(blur), median(readback), median(total));
+      md << line;
+    }
+    kmd << "| " << bm.name << " | " << bm.mesh.vertex_count() << " |";
+    for (int k : o.rings) {
+      SmoothOptions s;
+      s.rings = k;
+      t = Clock::now();
+      const std::vector<float> smoothed = smooth_field(bm.mesh, SdfDomain::Vertex, u, s);
+      const double ms = ms_since(t);
+      jm["kring_ms"].push_back({{"k", k}, {"ms", ms}});
+      char cell[64];
+      std::snprintf(cell, sizeof cell, " %.0f |", ms);
+      kmd << cell;
+    }
+    kmd << "\n";
+    out["meshes"].push_back(jm);
+  }
+  markdown = md.str() + kmd.str();
+  return out;
+}
+
+}  // namespace sdfkit::bench

@@ -1,0 +1,356 @@
+// Texture-space diffusion: the host side of diffuse.hpp. Builds the triangle soup, the chart
+// table, the blur's line jobs and the vertex queries in upload memory, then one render graph of
+// the passes in passes/atlas_*.cpp, executed once; values (and the atlas) are read from mapped
+// memory.
+
+#include "sdfkit/diffusion/diffuse.hpp"
+
+#include "atlas_passes.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/post/smooth.hpp"
+#include "sdfkit/vulkan/context.hpp"
+#include "sdfkit/vulkan/memory.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <string_view>
+
+namespace sdfkit::diffusion {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+constexpr VkFormat kRasterFormat = VK_FORMAT_R32G32_SFLOAT;
+
+vk::Pipeline make_raster_pipeline(vk::Context& ctx) {
+  vk::GraphicsPipelineDescription d;
+  d.vertex_shader = "atlas_raster.vert";
+  d.fragment_shader = "atlas_raster.frag";
+  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+  d.push_bytes = sizeof(passes::RasterPush);
+  d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, uv)},
+                  {1, 0, VK_FORMAT_R32_SFLOAT, offsetof(passes::RasterVertex, value)},
+                  {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)}};
+  d.vertex_stride = sizeof(passes::RasterVertex);
+  d.color_formats = {kRasterFormat};
+  d.depth_write = false;
+  return vk::create_graphics_pipeline(ctx, d);
+}
+
+vk::Pipeline make_compute(vk::Context& ctx, std::string_view shader, std::size_t buffers, std::uint32_t push) {
+  const std::vector<VkDescriptorType> b(buffers, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+  return vk::create_compute_pipeline(ctx, shader, b, push);
+}
+
+vk::ExternalBuffer host_written(const vk::Buffer& b) {
+  vk::ExternalBuffer e;
+  e.buffer = b.get();
+  e.initial = {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED};
+  return e;
+}
+
+// A buffer of at least 16 bytes (Vulkan refuses empty ones).
+vk::Buffer make_buffer(vk::Context& ctx, std::size_t bytes, VkBufferUsageFlags usage, vk::MemoryUse use) {
+  return vk::create_buffer(ctx, std::max<std::size_t>(bytes, 16), usage, use);
+}
+
+// The blur's sigma in a chart's texels. With sigma in model units, the variance the linear
+// interpolation over the triangles already contributes is taken off, so that blur ∘ interpolation
+// has the Gaussian's variance: a 1D hat of half-width h has h² / 6; over triangles whose mean edge
+// (diagonals included) is h we take h² / 4 per axis, the value that matched heat diffusion best on
+// the isometric cylinder of tests/diffusion (h² / 6 left sigma = 1 edge 10 % further from it).
+float sigma_px_of(const Chart& chart, const DiffuseOptions& o, float mean_edge) {
+  if (o.radius_px > 0.0f) return o.radius_px;
+  const double s = static_cast<double>(o.sigma) * chart.texels_per_unit;
+  const double h = static_cast<double>(mean_edge) * chart.texels_per_unit;
+  return static_cast<float>(std::sqrt(std::max(s * s - h * h / 4.0, 0.0)));
+}
+
+void check_options(const DiffuseOptions& o) {
+  const bool r = o.radius_px > 0.0f, s = o.sigma > 0.0f;
+  if (!std::isfinite(o.radius_px) || !std::isfinite(o.sigma) || o.radius_px < 0.0f || o.sigma < 0.0f)
+    throw InputError("the diffusion's radius and sigma must be finite and positive");
+  if (r == s) throw InputError("texture-space diffusion needs exactly one of a radius in texels or a sigma in model units");
+}
+
+}  // namespace
+
+std::array<std::uint32_t, 3> box_radii(float sigma_px) {
+  if (!(sigma_px > 0.0f)) return {0, 0, 0};
+  // Kovesi: n boxes of two odd widths wl and wl + 2, m of them the smaller, variance sigma².
+  constexpr double n = 3.0;
+  const double s2 = static_cast<double>(sigma_px) * sigma_px;
+  const double ideal = std::sqrt(12.0 * s2 / n + 1.0);
+  auto wl = static_cast<long>(std::floor(ideal));
+  if (wl % 2 == 0) --wl;
+  wl = std::max(wl, 1L);
+  const double m_ideal = (12.0 * s2 - n * wl * wl - 4.0 * n * wl - 3.0 * n) / (-4.0 * wl - 4.0);
+  const long m = std::clamp(std::lround(m_ideal), 0L, 3L);
+  std::array<std::uint32_t, 3> r{};
+  for (long i = 0; i < 3; ++i) r[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(((i < m ? wl : wl + 2) - 1) / 2);
+  return r;
+}
+
+BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge) {
+  check_options(options);
+  BlurPlan plan;
+  plan.dispatches = passes::kBlurDispatches;
+  for (const Chart& c : mapping.charts) {
+    auto r = box_radii(sigma_px_of(c, options, mean_edge));
+    // A periodic box no wider than the period (the shader wraps an index once at most).
+    if (c.wraps_x)
+      for (std::uint32_t& x : r) x = std::min(x, c.width > 1 ? (c.width - 1) / 2 : 0u);
+    plan.radii.push_back(r);
+    plan.line_jobs += std::uint64_t{c.width} + c.height;
+    for (std::uint32_t box = 0; box < 3; ++box) {
+      const std::uint64_t window = 2ull * r[box] + 1;
+      plan.texel_reads += std::uint64_t{c.height} * (2ull * c.width + window);  // rows
+      plan.texel_reads += std::uint64_t{c.width} * (2ull * c.height + window);  // columns
+    }
+  }
+  return plan;
+}
+
+void validate_mapping(const Mesh& mesh, const AtlasMapping& m) {
+  const std::size_t V = mesh.vertex_count();
+  if (m.size == 0) throw InputError("the atlas is empty (size 0)");
+  if (m.vertex_chart.size() != V || m.vertex_uv.size() != V)
+    throw InputError("the atlas mapping has " + std::to_string(m.vertex_chart.size()) + " vertex charts and " +
+                     std::to_string(m.vertex_uv.size()) + " vertex uvs for a mesh of " + std::to_string(V) +
+                     " vertices");
+  for (std::size_t c = 0; c < m.charts.size(); ++c) {
+    const Chart& ch = m.charts[c];
+    if (ch.width == 0 || ch.height == 0 || std::uint64_t{ch.x0} + ch.width > m.size ||
+        std::uint64_t{ch.y0} + ch.height > m.size)
+      throw InputError("chart " + std::to_string(c) + "'s rectangle is empty or leaves the " +
+                       std::to_string(m.size) + "² atlas");
+    if (!std::isfinite(ch.texels_per_unit) || ch.texels_per_unit < 0.0f)
+      throw InputError("chart " + std::to_string(c) + " has no valid scale (texels_per_unit)");
+  }
+  const auto inside = [&](const Chart& ch, glm::vec2 uv, float slack) {
+    return uv.x >= static_cast<float>(ch.x0) - slack && uv.y >= static_cast<float>(ch.y0) - slack &&
+           uv.x <= static_cast<float>(ch.x0 + ch.width) + slack && uv.y <= static_cast<float>(ch.y0 + ch.height) + slack;
+  };
+  for (std::size_t v = 0; v < V; ++v) {
+    const std::uint32_t c = m.vertex_chart[v];
+    if (c >= m.charts.size())
+      throw InputError("vertex " + std::to_string(v) + " reads back from chart " + std::to_string(c) + " of " +
+                       std::to_string(m.charts.size()));
+    if (!inside(m.charts[c], m.vertex_uv[v], 0.01f))
+      throw InputError("vertex " + std::to_string(v) + "'s uv lies outside its chart " + std::to_string(c));
+  }
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const AtlasTriangle& tri = m.triangles[t];
+    if (tri.chart >= m.charts.size() || tri.face >= mesh.face_count())
+      throw InputError("atlas triangle " + std::to_string(t) + " names chart " + std::to_string(tri.chart) +
+                       " / face " + std::to_string(tri.face) + " that do not exist");
+    const Chart& ch = m.charts[tri.chart];
+    // A wrapping chart's triangle may reach a width beyond its rectangle (across the seam).
+    const float slack = ch.wraps_x ? static_cast<float>(ch.width) : 0.01f;
+    for (const glm::vec2& uv : tri.uv)
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y) || !inside(ch, uv, slack))
+        throw InputError("atlas triangle " + std::to_string(t) + " has a corner outside its chart " +
+                         std::to_string(tri.chart));
+  }
+}
+
+int kring_for_sigma(float sigma, float mean_edge) {
+  if (!(sigma > 0.0f) || !(mean_edge > 0.0f)) return 1;
+  return std::max(1, static_cast<int>(std::ceil(2.0f * sigma / mean_edge - 1e-4f)));
+}
+
+struct Diffuser::Impl {
+  explicit Impl(vk::Context& c)
+      : ctx(c),
+        raster(make_raster_pipeline(c)),
+        blur(make_compute(c, "atlas_blur.comp", 4, sizeof(passes::BlurPush))),
+        sample(make_compute(c, "atlas_sample.comp", 4, sizeof(passes::SamplePush))),
+        dilate(make_compute(c, "atlas_dilate.comp", 3, sizeof(passes::DilatePush))),
+        transients(c) {}
+  vk::Context& ctx;
+  vk::Pipeline raster, blur, sample, dilate;
+  vk::TransientPool transients;
+};
+
+Diffuser::Diffuser(vk::Context& ctx) : impl_(std::make_unique<Impl>(ctx)) {}
+Diffuser::~Diffuser() = default;
+
+DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::span<const float> values,
+                            const DiffuseOptions& options) {
+  const auto start = Clock::now();
+  vk::Context& ctx = impl_->ctx;
+  check_options(options);
+  validate_mapping(mesh, mapping);
+  const std::size_t V = mesh.vertex_count();
+  if (values.size() != V)
+    throw InputError("diffusion of " + std::to_string(values.size()) + " values on a mesh of " + std::to_string(V) +
+                     " vertices");
+  for (std::size_t v = 0; v < V; ++v)
+    if (!std::isfinite(values[v])) throw InputError("vertex " + std::to_string(v) + "'s value is not finite");
+  const std::uint32_t size = mapping.size;
+  const std::uint32_t max_side = ctx.capabilities().max_image_dimension_2d;
+  const VkDeviceSize texel_bytes = passes::tiled_texel_bytes(size);
+  if ((max_side && size > max_side) ||
+      (ctx.capabilities().max_storage_buffer_range && texel_bytes > ctx.capabilities().max_storage_buffer_range))
+    throw DeviceError("a " + std::to_string(size) + "² atlas is larger than the device allows");
+
+  DiffuseResult result;
+  result.plan = plan_blur(mapping, options, options.sigma > 0.0f ? mean_edge_length(mesh) : 0.0f);
+
+  // Chart table.
+  std::vector<passes::GpuChart> charts;
+  charts.reserve(mapping.charts.size());
+  for (std::size_t c = 0; c < mapping.charts.size(); ++c) {
+    const Chart& ch = mapping.charts[c];
+    const auto& r = result.plan.radii[c];
+    charts.push_back({glm::uvec4(ch.x0, ch.y0, ch.width, ch.height), glm::uvec4(r[0], r[1], r[2], ch.wraps_x ? 1u : 0u)});
+  }
+  vk::Buffer chart_buf = make_buffer(ctx, charts.size() * sizeof(passes::GpuChart), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                     vk::MemoryUse::Upload);
+  if (!charts.empty()) std::memcpy(chart_buf.mapped(), charts.data(), charts.size() * sizeof(passes::GpuChart));
+
+  // Triangle soup: a triangle of a wrapping chart is unwrapped around its first corner and drawn
+  // at every shift by the chart's width that reaches the rectangle (the shader clips).
+  std::vector<passes::RasterVertex> soup;
+  soup.reserve(3 * mapping.triangles.size() + 64);
+  for (const AtlasTriangle& t : mapping.triangles) {
+    const Chart& ch = mapping.charts[t.chart];
+    const auto& face = mesh.triangles[t.face];
+    glm::vec2 uv[3] = {t.uv[0], t.uv[1], t.uv[2]};
+    if (!ch.wraps_x) {
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], values[face[k]], t.chart});
+      continue;
+    }
+    const float w = static_cast<float>(ch.width);
+    for (int k = 1; k < 3; ++k) {
+      while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
+      while (uv[0].x - uv[k].x > 0.5f * w) uv[k].x += w;
+    }
+    const float lo = std::min({uv[0].x, uv[1].x, uv[2].x}), hi = std::max({uv[0].x, uv[1].x, uv[2].x});
+    for (int s = -2; s <= 2; ++s) {
+      const float shift = static_cast<float>(s) * w;
+      if (hi + shift <= static_cast<float>(ch.x0) || lo + shift >= static_cast<float>(ch.x0) + w) continue;
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), values[face[k]], t.chart});
+    }
+  }
+  vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                                    vk::MemoryUse::Upload);
+  if (!soup.empty()) std::memcpy(soup_buf.mapped(), soup.data(), soup.size() * sizeof(passes::RasterVertex));
+
+  // Line jobs of the blur: every row of every chart, then every column.
+  std::vector<glm::uvec2> jobs;
+  jobs.reserve(result.plan.line_jobs);
+  for (std::uint32_t c = 0; c < charts.size(); ++c)
+    for (std::uint32_t y = 0; y < mapping.charts[c].height; ++y) jobs.emplace_back(c, y);
+  const auto row_jobs = static_cast<std::uint32_t>(jobs.size());
+  for (std::uint32_t c = 0; c < charts.size(); ++c)
+    for (std::uint32_t x = 0; x < mapping.charts[c].width; ++x) jobs.emplace_back(c, x);
+  const auto column_jobs = static_cast<std::uint32_t>(jobs.size()) - row_jobs;
+  vk::Buffer job_buf = make_buffer(ctx, jobs.size() * sizeof(glm::uvec2), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                   vk::MemoryUse::Upload);
+  if (!jobs.empty()) std::memcpy(job_buf.mapped(), jobs.data(), jobs.size() * sizeof(glm::uvec2));
+
+  // Vertex queries and the read-back buffers.
+  vk::Buffer query_buf = make_buffer(ctx, V * sizeof(passes::SampleQuery), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                     vk::MemoryUse::Upload);
+  auto* q = static_cast<passes::SampleQuery*>(query_buf.mapped());
+  for (std::size_t v = 0; v < V; ++v) q[v] = {mapping.vertex_uv[v], mapping.vertex_chart[v], values[v]};
+  vk::Buffer value_buf = make_buffer(ctx, V * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Readback);
+  vk::Buffer atlas_buf;
+  if (options.keep_atlas)
+    atlas_buf = make_buffer(ctx, VkDeviceSize{size} * size * sizeof(float),
+                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+  result.timings.prepare = ms_since(start);
+
+  // The graph.
+  vk::RenderGraph graph;
+  const auto chart_h = graph.import_buffer("atlas.charts", chart_buf.size, host_written(chart_buf));
+  const auto soup_h = graph.import_buffer("atlas.triangles", soup_buf.size, host_written(soup_buf));
+  const auto job_h = graph.import_buffer("atlas.blur_jobs", job_buf.size, host_written(job_buf));
+  const auto query_h = graph.import_buffer("atlas.queries", query_buf.size, host_written(query_buf));
+  const auto value_h = graph.import_buffer("atlas.values", value_buf.size, {value_buf.get()});
+  const auto target = graph.create_image("atlas.raster", {kRasterFormat, size, size, 1});
+  const auto texels = graph.create_buffer("atlas.texels", texel_bytes);
+  const auto scratch = graph.create_buffer("atlas.scratch", texel_bytes);
+
+  passes::AtlasRasterPass rp;
+  rp.pipeline = &impl_->raster;
+  rp.target = target;
+  rp.vertices = soup_h;
+  rp.charts = chart_h;
+  rp.texels = texels;
+  rp.vertex_count = static_cast<std::uint32_t>(soup.size());
+  rp.size = size;
+  const auto rastered = passes::add_atlas_raster_pass(graph, rp);
+
+  passes::AtlasBlurPass bp;
+  bp.pipeline = &impl_->blur;
+  bp.texels = rastered;
+  bp.scratch = scratch;
+  bp.charts = chart_h;
+  bp.jobs = job_h;
+  bp.row_jobs = row_jobs;
+  bp.column_jobs = column_jobs;
+  bp.size = size;
+  const auto blurred = options.blur ? passes::add_atlas_blur_passes(graph, bp) : rastered;
+
+  passes::AtlasSamplePass sp;
+  sp.pipeline = &impl_->sample;
+  sp.texels = blurred;
+  sp.charts = chart_h;
+  sp.queries = query_h;
+  sp.values = value_h;
+  sp.vertex_count = static_cast<std::uint32_t>(V);
+  sp.size = size;
+  passes::add_atlas_sample_pass(graph, sp);
+
+  if (options.keep_atlas) {
+    passes::AtlasDilatePass dp;
+    dp.pipeline = &impl_->dilate;
+    dp.texels = blurred;
+    dp.charts = chart_h;
+    dp.atlas = graph.import_buffer("atlas.dilated", atlas_buf.size, {atlas_buf.get()});
+    dp.chart_count = static_cast<std::uint32_t>(charts.size());
+    dp.size = size;
+    dp.margin = mapping.gutter / 2;
+    dp.charts_host = &charts;
+    passes::add_atlas_dilate_pass(graph, dp);
+  }
+
+  const auto exec_start = Clock::now();
+  vk::ExecuteOptions eo;
+  eo.profile = options.profile;
+  const std::vector<vk::PassTiming> timings = vk::execute(ctx, graph.compile(), impl_->transients, eo);
+  result.timings.execute = ms_since(exec_start);
+  for (const vk::PassTiming& t : timings) {
+    const std::string_view name = t.pass;
+    if (name.starts_with("atlas.raster")) result.timings.raster += t.gpu_milliseconds;
+    else if (name.starts_with("atlas.blur")) result.timings.blur += t.gpu_milliseconds;
+    else result.timings.sample += t.gpu_milliseconds;
+  }
+
+  const auto read_start = Clock::now();
+  result.values.resize(V);
+  if (V) std::memcpy(result.values.data(), value_buf.mapped(), V * sizeof(float));
+  if (options.keep_atlas) {
+    result.atlas.resize(std::size_t{size} * size);
+    std::memcpy(result.atlas.data(), atlas_buf.mapped(), result.atlas.size() * sizeof(float));
+  }
+  result.timings.readback = ms_since(read_start);
+  result.timings.total = ms_since(start);
+  return result;
+}
+
+std::vector<float> diffuse(vk::Context& ctx, const Mesh& mesh, const AtlasMapping& mapping,
+                           std::span<const float> vertex_values, const DiffuseOptions& options) {
+  Diffuser d(ctx);
+  return d.run(mesh, mapping, vertex_values, options).values;
+}
+
+}  // namespace sdfkit::diffusion

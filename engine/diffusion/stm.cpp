@@ -1,0 +1,802 @@
+// Skeleton texture mapping: charts from a skeleton, their parameterizations, packing, quality.
+// The road (build_stm): vertex → node ──▶ bones (chains between joints) with rotation-minimizing
+// frames ──▶ each vertex to a bone, an end cap or a planar region ──▶ demote the vertices of
+// stretched or flipped triangles to planar regions (repeat) ──▶ planar regions split into charts
+// by normal direction ──▶ atlas triangles (one per face and chart it touches) ──▶ chart extents
+// ──▶ scale and shelf packing ──▶ texel coordinates ──▶ quality.
+#include "sdfkit/diffusion/stm.hpp"
+
+#include "sdfkit/core/error.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <numeric>
+
+namespace sdfkit::diffusion {
+namespace {
+
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+constexpr double kTwoPi = 6.283185307179586;
+// Angle distortion of a triangle mapped to a segment or point (σ2 = 0), and the cap of all.
+constexpr double kMaxAngleDistortion = 1000.0;
+
+// A skeleton segment between joints: the polyline through its nodes' positions, arc length at
+// each point, and a rotation-minimizing frame (n, b) per segment (double reflection, Wang et al.
+// 2008), t = the segment's direction.
+struct Bone {
+  std::vector<std::uint32_t> nodes;  // first and last are joints (or the same node, for a loop)
+  std::vector<glm::dvec3> points;
+  std::vector<double> s;             // arc length at each point
+  std::vector<glm::dvec3> t, n, b;   // per segment
+  std::vector<glm::dvec3> m;         // per point: normal of the plane bisecting the bend there
+  double length = 0;
+  double radius = 0;                 // median distance of its vertices to the polyline
+};
+
+// Closest point of p on a bone's polyline.
+struct BonePoint {
+  double dist = 0, s = 0;
+  std::size_t seg = 0;
+  bool clamped = false;  // beyond the polyline's first or last point (s extrapolated)
+  glm::dvec3 radial{0.0};  // p - closest point
+};
+
+// The point of a bone's polyline that p projects to. Between the planes that bisect the
+// polyline's bends (normal m_i = the mean of the adjacent segments' directions; at the ends the
+// end segment's direction), p belongs to the segment whose slab holds it and is parameterized
+// by λ = d0 / (d0 - d1), its signed distances to the slab's planes: continuous across a bend,
+// where the plain closest point jumps on the inner side and stalls on the outer side. Several
+// slabs can hold p far from the polyline: the one whose point is nearest wins. p in no slab
+// (beyond an end): the closest point, clamped.
+BonePoint closest_on_bone(const Bone& bone, const glm::dvec3& p) {
+  BonePoint best;
+  best.dist = std::numeric_limits<double>::infinity();
+  const std::size_t segs = bone.t.size();
+  for (std::size_t i = 0; i < segs; ++i) {
+    const glm::dvec3 a = bone.points[i], b = bone.points[i + 1];
+    const double len = bone.s[i + 1] - bone.s[i];
+    const double d0 = glm::dot(p - a, bone.m[i]), d1 = glm::dot(p - b, bone.m[i + 1]);
+    if (!(d0 >= 0 && d1 <= 0 && d0 - d1 > 0)) continue;
+    const double lambda = d0 / (d0 - d1);
+    const glm::dvec3 q = a + (b - a) * lambda;
+    const double d = glm::length(p - q);
+    if (d < best.dist) best = {d, bone.s[i] + lambda * len, i, false, p - q};
+  }
+  if (std::isfinite(best.dist)) return best;
+  for (std::size_t i = 0; i < segs; ++i) {
+    const glm::dvec3 a = bone.points[i];
+    const double len = bone.s[i + 1] - bone.s[i];
+    double x = glm::dot(p - a, bone.t[i]);
+    // Beyond an end the polyline is extended along the end segment (a neighbouring chart's
+    // vertex keeps its distance from the end instead of collapsing onto it).
+    bool clamped = false;
+    if (x < 0) {
+      clamped = i == 0;
+      if (!clamped) x = 0;
+    } else if (x > len) {
+      clamped = i + 1 == segs;
+      if (!clamped) x = len;
+    }
+    const glm::dvec3 q = a + bone.t[i] * x;
+    const double d = glm::length(p - q);
+    if (d < best.dist) best = {d, bone.s[i] + x, i, clamped, p - q};
+  }
+  return best;
+}
+
+// Angle of the radial vector around segment `seg`'s frame, in [0, 2π).
+double bone_angle(const Bone& bone, std::size_t seg, const glm::dvec3& radial) {
+  double a = std::atan2(glm::dot(radial, bone.b[seg]), glm::dot(radial, bone.n[seg]));
+  if (a < 0) a += kTwoPi;
+  return a >= kTwoPi ? 0.0 : a;
+}
+
+glm::dvec3 any_perpendicular(const glm::dvec3& t) {
+  const glm::dvec3 ax = std::abs(t.x) <= std::abs(t.y) && std::abs(t.x) <= std::abs(t.z) ? glm::dvec3(1, 0, 0)
+                        : std::abs(t.y) <= std::abs(t.z)                                 ? glm::dvec3(0, 1, 0)
+                                                                                         : glm::dvec3(0, 0, 1);
+  return glm::normalize(glm::cross(t, ax));
+}
+
+void build_frames(Bone& bone) {
+  const std::size_t segs = bone.points.size() - 1;
+  bone.s.assign(bone.points.size(), 0.0);
+  for (std::size_t i = 0; i < segs; ++i) {
+    const glm::dvec3 d = bone.points[i + 1] - bone.points[i];
+    const double len = glm::length(d);
+    bone.s[i + 1] = bone.s[i] + len;
+    bone.t.push_back(len > 0 ? d / len : (i > 0 ? bone.t[i - 1] : glm::dvec3(0, 0, 1)));
+  }
+  bone.length = bone.s.back();
+  bone.m.resize(bone.points.size());
+  bone.m.front() = bone.t.front();
+  bone.m.back() = bone.t.back();
+  for (std::size_t i = 1; i < segs; ++i) {
+    const glm::dvec3 mid = bone.t[i - 1] + bone.t[i];
+    const double ml = glm::length(mid);
+    bone.m[i] = ml > 1e-9 ? mid / ml : bone.t[i];
+  }
+  bone.n.resize(segs);
+  bone.b.resize(segs);
+  bone.n[0] = any_perpendicular(bone.t[0]);
+  bone.b[0] = glm::cross(bone.t[0], bone.n[0]);
+  for (std::size_t i = 1; i < segs; ++i) {
+    // Double reflection between consecutive segment frames, both "located" at the shared point.
+    const glm::dvec3 v1 = bone.points[i] - bone.points[i - 1];
+    const double c1 = glm::dot(v1, v1);
+    glm::dvec3 r = bone.n[i - 1], tl = bone.t[i - 1];
+    if (c1 > 0) {
+      r -= (2.0 / c1) * glm::dot(v1, r) * v1;
+      tl -= (2.0 / c1) * glm::dot(v1, tl) * v1;
+    }
+    const glm::dvec3 v2 = bone.t[i] - tl;
+    const double c2 = glm::dot(v2, v2);
+    if (c2 > 1e-24) r -= (2.0 / c2) * glm::dot(v2, r) * v2;
+    r -= bone.t[i] * glm::dot(r, bone.t[i]);
+    const double rl = glm::length(r);
+    bone.n[i] = rl > 1e-12 ? r / rl : any_perpendicular(bone.t[i]);
+    bone.b[i] = glm::cross(bone.t[i], bone.n[i]);
+  }
+}
+
+enum class Region : std::uint8_t { Bone, Cap, Joint, Sheet };
+
+// How a chart maps a model point to its local plane (model units).
+struct ChartMap {
+  Chart::Kind kind = Chart::Kind::Bone;
+  std::uint32_t bone = kNone;   // Bone: index into bones
+  double width = 0;             // Bone: 2π × radius (x wraps there)
+  glm::dvec3 origin{0.0}, axis{0.0}, b1{0.0}, b2{0.0};  // Cap / planar
+  double cap_radius = 0;        // Cap: ρ = polar angle × cap_radius
+  bool cap = false;
+  // Local extent (after collection), model units.
+  glm::dvec2 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
+};
+
+glm::dvec2 local_coords(const ChartMap& c, const std::vector<Bone>& bones, const glm::dvec3& p) {
+  if (c.kind == Chart::Kind::Bone) {
+    const Bone& bone = bones[c.bone];
+    const BonePoint bp = closest_on_bone(bone, p);
+    return {bone_angle(bone, bp.seg, bp.radial) / kTwoPi * c.width, bp.s};
+  }
+  const glm::dvec3 q = p - c.origin;
+  if (c.cap) {
+    const double lq = glm::length(q);
+    if (lq <= 0) return {0, 0};
+    const double polar = std::atan2(glm::length(glm::cross(q, c.axis)), glm::dot(q, c.axis));
+    const glm::dvec2 dir(glm::dot(q, c.b1), glm::dot(q, c.b2));
+    const double dl = glm::length(dir);
+    if (dl <= 0) return {0, 0};
+    return dir / dl * (polar * c.cap_radius);
+  }
+  return {glm::dot(q, c.b1), glm::dot(q, c.b2)};
+}
+
+// Unwraps x of wrapping-chart corners toward the reference corner's x.
+void unwrap(glm::dvec2 (&uv)[3], int ref, double width) {
+  for (int k = 0; k < 3; ++k)
+    if (k != ref) uv[k].x += width * std::round((uv[ref].x - uv[k].x) / width);
+}
+
+double signed_area2(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+// Area-weighted mean, 95th percentile and maximum.
+Stats weighted_stats(std::vector<std::pair<double, double>> value_weight) {
+  Stats st;
+  if (value_weight.empty()) return st;
+  std::sort(value_weight.begin(), value_weight.end());
+  double wsum = 0, vsum = 0;
+  for (const auto& [v, w] : value_weight) wsum += w, vsum += v * w;
+  st.mean = wsum > 0 ? vsum / wsum : value_weight.front().first;
+  st.max = value_weight.back().first;
+  double acc = 0;
+  st.p95 = st.max;
+  for (const auto& [v, w] : value_weight) {
+    acc += w;
+    if (wsum > 0 && acc >= 0.95 * wsum) {
+      st.p95 = v;
+      break;
+    }
+  }
+  return st;
+}
+
+struct Packed {
+  std::vector<std::uint32_t> x, y, w, h;
+  bool fits = false;
+};
+
+// Shelf packing: rectangles sorted by height (then width, then index), placed left to right in
+// rows; `gutter` texels between rectangles and along the atlas border.
+Packed shelf_pack(const std::vector<std::uint32_t>& w, const std::vector<std::uint32_t>& h, std::uint32_t size,
+                  std::uint32_t gutter) {
+  Packed p;
+  p.w = w;
+  p.h = h;
+  p.x.assign(w.size(), 0);
+  p.y.assign(w.size(), 0);
+  std::vector<std::uint32_t> order(w.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    if (h[a] != h[b]) return h[a] > h[b];
+    if (w[a] != w[b]) return w[a] > w[b];
+    return a < b;
+  });
+  std::uint64_t x = gutter, y = gutter, row_h = 0;
+  for (std::uint32_t i : order) {
+    if (w[i] + 2ull * gutter > size) return p;
+    if (x + w[i] + gutter > size) {
+      y += row_h + gutter;
+      x = gutter;
+      row_h = 0;
+    }
+    if (y + h[i] + gutter > size) return p;
+    p.x[i] = static_cast<std::uint32_t>(x);
+    p.y[i] = static_cast<std::uint32_t>(y);
+    x += w[i] + gutter;
+    row_h = std::max<std::uint64_t>(row_h, h[i]);
+  }
+  p.fits = true;
+  return p;
+}
+
+// Singular values (σ1 ≥ σ2) of the 2×2 matrix [a b; c d].
+std::pair<double, double> singular_values(double a, double b, double c, double d) {
+  const double e = (a + d) / 2, f = (a - d) / 2, g = (c + b) / 2, h = (c - b) / 2;
+  const double q = std::hypot(e, h), r = std::hypot(f, g);
+  return {q + r, std::abs(q - r)};
+}
+
+}  // namespace
+
+Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t V = mesh.positions.size(), F = mesh.triangles.size();
+  if (V == 0 || F == 0) throw InputError("skeleton texture mapping: the mesh has no triangles");
+  if (skel.nodes.empty()) throw InputError("skeleton texture mapping: the skeleton has no nodes");
+  if (options.atlas_size < 16 || options.atlas_size > 16384)
+    throw UsageError("skeleton texture mapping: the atlas size must be 16 to 16384 texels");
+  if (options.gutter > 64 || 4u * options.gutter + 4 > options.atlas_size)
+    throw UsageError("skeleton texture mapping: the gutter must be 0 to 64 texels and leave room in the atlas");
+  if (!(options.max_normal_angle_deg > 0 && options.max_normal_angle_deg <= 90))
+    throw UsageError("skeleton texture mapping: max_normal_angle_deg must be in (0, 90]");
+  if (!(options.max_stretch >= 1.0 && std::isfinite(options.max_stretch)))
+    throw UsageError("skeleton texture mapping: max_stretch must be at least 1");
+  for (const Triangle& t : mesh.triangles)
+    for (std::uint32_t v : t)
+      if (v >= V) throw InputError("skeleton texture mapping: a triangle index is out of range");
+  const std::size_t N = skel.nodes.size();
+  for (const auto& e : skel.edges)
+    if (e[0] >= N || e[1] >= N) throw InputError("skeleton texture mapping: a skeleton edge refers to a missing node");
+
+  // Mesh adjacency (CSR).
+  std::vector<std::uint32_t> adj_start(V + 1, 0), adj;
+  {
+    for (const Triangle& t : mesh.triangles)
+      for (int k = 0; k < 3; ++k) adj_start[t[k] + 1] += 2;
+    for (std::size_t i = 0; i < V; ++i) adj_start[i + 1] += adj_start[i];
+    adj.resize(adj_start[V]);
+    std::vector<std::uint32_t> fill(adj_start.begin(), adj_start.end() - 1);
+    for (const Triangle& t : mesh.triangles)
+      for (int k = 0; k < 3; ++k) {
+        adj[fill[t[k]]++] = t[(k + 1) % 3];
+        adj[fill[t[k]]++] = t[(k + 2) % 3];
+      }
+  }
+
+  // 1. Vertex → node; vertices no node holds take a neighbour's node (breadth first), isolated
+  // ones the nearest node.
+  std::vector<std::uint32_t> vnode(V, kNone);
+  std::deque<std::uint32_t> queue;
+  for (std::size_t i = 0; i < N; ++i)
+    for (std::uint32_t v : skel.nodes[i].vertices) {
+      if (v >= V) throw InputError("skeleton texture mapping: skeleton node " + std::to_string(i) +
+                                   " holds vertex " + std::to_string(v) + ", the mesh has " + std::to_string(V));
+      if (vnode[v] == kNone) vnode[v] = static_cast<std::uint32_t>(i), queue.push_back(v);
+    }
+  while (!queue.empty()) {
+    const std::uint32_t v = queue.front();
+    queue.pop_front();
+    for (std::uint32_t k = adj_start[v]; k < adj_start[v + 1]; ++k)
+      if (vnode[adj[k]] == kNone) vnode[adj[k]] = vnode[v], queue.push_back(adj[k]);
+  }
+  for (std::size_t v = 0; v < V; ++v)
+    if (vnode[v] == kNone) {
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < N; ++i) {
+        const double d = glm::length(glm::dvec3(mesh.positions[v]) - glm::dvec3(skel.nodes[i].position));
+        if (d < best) best = d, vnode[v] = static_cast<std::uint32_t>(i);
+      }
+    }
+
+  // 2. Bones: chains of curve nodes of degree 2 between curve nodes of other degree.
+  std::vector<std::vector<std::uint32_t>> nbr(N);
+  for (const auto& e : skel.edges)
+    if (e[0] != e[1] && !skel.nodes[e[0]].sheet && !skel.nodes[e[1]].sheet) {
+      nbr[e[0]].push_back(e[1]);
+      nbr[e[1]].push_back(e[0]);
+    }
+  for (auto& l : nbr) {
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+  }
+  std::vector<std::uint8_t> joint(N, 0);
+  for (std::size_t i = 0; i < N; ++i) joint[i] = !skel.nodes[i].sheet && nbr[i].size() != 2;
+  std::vector<Bone> bones;
+  std::vector<std::uint32_t> node_bone(N, kNone);  // for interior nodes
+  std::vector<std::vector<std::uint32_t>> joint_bones(N);
+  std::vector<std::uint8_t> walked(N, 0);
+  const auto walk = [&](std::uint32_t from, std::uint32_t next) {
+    Bone bone;
+    bone.nodes = {from};
+    std::uint32_t prev = from, cur = next;
+    while (!joint[cur]) {
+      walked[cur] = 1;
+      bone.nodes.push_back(cur);
+      const std::uint32_t nx = nbr[cur][0] == prev ? nbr[cur][1] : nbr[cur][0];
+      prev = cur;
+      cur = nx;
+    }
+    bone.nodes.push_back(cur);
+    return bone;
+  };
+  const auto add_bone = [&](Bone bone) {
+    for (std::uint32_t n : bone.nodes) bone.points.push_back(glm::dvec3(skel.nodes[n].position));
+    build_frames(bone);
+    if (!(bone.length > 0)) return;
+    const auto id = static_cast<std::uint32_t>(bones.size());
+    for (std::size_t k = 1; k + 1 < bone.nodes.size(); ++k) node_bone[bone.nodes[k]] = id;
+    joint_bones[bone.nodes.front()].push_back(id);
+    if (bone.nodes.back() != bone.nodes.front()) joint_bones[bone.nodes.back()].push_back(id);
+    bones.push_back(std::move(bone));
+  };
+  for (std::uint32_t j = 0; j < N; ++j) {
+    if (!joint[j]) continue;
+    for (std::uint32_t nb : nbr[j]) {
+      if (joint[nb]) {
+        if (j < nb) add_bone(walk(j, nb));
+        continue;
+      }
+      if (walked[nb]) continue;
+      add_bone(walk(j, nb));
+    }
+  }
+  // Loops of degree-2 nodes: the smallest node becomes a joint where the loop is cut.
+  for (std::uint32_t i = 0; i < N; ++i) {
+    if (skel.nodes[i].sheet || joint[i] || walked[i] || nbr[i].size() != 2) continue;
+    joint[i] = 1;
+    walked[i] = 1;
+    add_bone(walk(i, nbr[i][0]));
+  }
+
+  // 3. Each vertex to a bone, a cap or a planar region.
+  const std::vector<glm::vec3> normals = vertex_normals(mesh);
+  const double cos_max = std::cos(options.max_normal_angle_deg * kTwoPi / 360.0);
+  const double diag = bounding_box(mesh.positions).diagonal();
+  std::vector<Region> region(V, Region::Joint);
+  std::vector<std::uint32_t> owner(V, kNone);  // bone index (Bone) or node (Cap)
+  std::vector<double> radial(V, 0.0);
+  for (std::size_t v = 0; v < V; ++v) {
+    const std::uint32_t nd = vnode[v];
+    if (skel.nodes[nd].sheet) {
+      region[v] = Region::Sheet;
+      continue;
+    }
+    std::vector<std::uint32_t> cands;
+    if (node_bone[nd] != kNone) cands.push_back(node_bone[nd]);
+    else cands = joint_bones[nd];
+    if (cands.empty()) continue;  // an isolated node: planar joint region
+    const glm::dvec3 p(mesh.positions[v]);
+    std::uint32_t bi = kNone;
+    BonePoint bp;
+    for (std::uint32_t c : cands) {
+      const BonePoint q = closest_on_bone(bones[c], p);
+      if (bi == kNone || q.dist < bp.dist) bi = c, bp = q;
+    }
+    const Bone& bone = bones[bi];
+    const glm::dvec3 n(normals[v]);
+    const double radius = std::max(1e-6 * diag, 0.05 * static_cast<double>(skel.nodes[nd].radius));
+    const bool ok = !bp.clamped && bp.dist > radius && std::abs(glm::dot(n, bone.t[bp.seg])) <= cos_max;
+    if (ok) {
+      region[v] = Region::Bone;
+      owner[v] = bi;
+      radial[v] = bp.dist;
+      continue;
+    }
+    const std::uint32_t end = bp.s < bone.length / 2 ? bone.nodes.front() : bone.nodes.back();
+    if (nbr[end].size() == 1 && bone.nodes.front() != bone.nodes.back()) {
+      region[v] = Region::Cap;
+      owner[v] = end;
+    }
+  }
+
+  std::vector<Bone>& B = bones;
+  // Per bone radius: median distance of its vertices; per cap: frame at the end.
+  const auto bone_radii = [&] {
+    std::vector<std::vector<double>> r(B.size());
+    for (std::size_t v = 0; v < V; ++v)
+      if (region[v] == Region::Bone) r[owner[v]].push_back(radial[v]);
+    for (std::size_t b = 0; b < B.size(); ++b) {
+      if (r[b].empty()) {
+        B[b].radius = 0;
+        continue;
+      }
+      auto mid = r[b].begin() + static_cast<std::ptrdiff_t>(r[b].size() / 2);
+      std::nth_element(r[b].begin(), mid, r[b].end());
+      B[b].radius = *mid;
+    }
+  };
+
+  // The charts of the current assignment, rebuilt after every demotion round.
+  std::vector<ChartMap> maps;
+  std::vector<std::uint32_t> vchart(V, kNone);
+  const auto build_charts = [&] {
+    maps.clear();
+    bone_radii();
+    std::vector<std::uint32_t> bone_chart(B.size(), kNone), cap_chart(N, kNone);
+    for (std::size_t v = 0; v < V; ++v) {
+      if (region[v] == Region::Bone) {
+        std::uint32_t& c = bone_chart[owner[v]];
+        if (c == kNone) {
+          ChartMap m;
+          m.kind = Chart::Kind::Bone;
+          m.bone = owner[v];
+          m.width = kTwoPi * B[owner[v]].radius;
+          c = static_cast<std::uint32_t>(maps.size());
+          maps.push_back(m);
+        }
+        vchart[v] = c;
+      } else if (region[v] == Region::Cap) {
+        std::uint32_t& c = cap_chart[owner[v]];
+        if (c == kNone) {
+          ChartMap m;
+          m.kind = Chart::Kind::Joint;
+          m.cap = true;
+          const std::uint32_t end = owner[v];
+          const Bone& bone = B[joint_bones[end][0]];
+          const bool at_front = bone.nodes.front() == end;
+          const std::size_t seg = at_front ? 0 : bone.t.size() - 1;
+          m.origin = glm::dvec3(skel.nodes[end].position);
+          m.axis = at_front ? -bone.t[seg] : bone.t[seg];
+          m.b1 = bone.n[seg];
+          m.b2 = glm::cross(m.axis, m.b1);
+          c = static_cast<std::uint32_t>(maps.size());
+          maps.push_back(m);
+        }
+        vchart[v] = c;
+      } else {
+        vchart[v] = kNone;
+      }
+    }
+    // Cap radius: mean distance of its vertices to the centre.
+    std::vector<double> sum(maps.size(), 0.0), cnt(maps.size(), 0.0);
+    for (std::size_t v = 0; v < V; ++v)
+      if (region[v] == Region::Cap) {
+        sum[vchart[v]] += glm::length(glm::dvec3(mesh.positions[v]) - maps[vchart[v]].origin);
+        cnt[vchart[v]] += 1;
+      }
+    for (std::size_t c = 0; c < maps.size(); ++c)
+      if (maps[c].cap) maps[c].cap_radius = cnt[c] > 0 ? sum[c] / cnt[c] : 0;
+
+    // Planar regions: connected components (same kind) of the remaining vertices, each split by
+    // the six principal directions of its positions into connected charts.
+    std::vector<std::uint32_t> comp(V, kNone);
+    std::uint32_t ncomp = 0;
+    std::vector<std::uint32_t> stack;
+    std::vector<std::vector<std::uint32_t>> members;
+    for (std::uint32_t v = 0; v < V; ++v) {
+      if (vchart[v] != kNone || comp[v] != kNone) continue;
+      members.emplace_back();
+      comp[v] = ncomp;
+      stack = {v};
+      while (!stack.empty()) {
+        const std::uint32_t a = stack.back();
+        stack.pop_back();
+        members.back().push_back(a);
+        for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
+          const std::uint32_t b = adj[k];
+          if (vchart[b] == kNone && comp[b] == kNone && region[b] == region[v]) comp[b] = ncomp, stack.push_back(b);
+        }
+      }
+      ++ncomp;
+    }
+    std::vector<std::uint8_t> cluster(V, 0);
+    for (std::uint32_t ci = 0; ci < ncomp; ++ci) {
+      const auto& mem = members[ci];
+      glm::dvec3 mean(0.0);
+      for (std::uint32_t v : mem) mean += glm::dvec3(mesh.positions[v]);
+      mean /= static_cast<double>(mem.size());
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (std::uint32_t v : mem) {
+        const glm::dvec3 d = glm::dvec3(mesh.positions[v]) - mean;
+        const Eigen::Vector3d e(d.x, d.y, d.z);
+        cov += e * e.transpose();
+      }
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+      glm::dvec3 axes[3];
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d e = es.eigenvectors().col(2 - k);
+        axes[k] = glm::dvec3(e.x(), e.y(), e.z());
+      }
+      if (mem.size() < 3 || !std::isfinite(axes[0].x)) axes[0] = {1, 0, 0}, axes[1] = {0, 1, 0}, axes[2] = {0, 0, 1};
+      // Orthonormal, right-handed.
+      axes[0] = glm::normalize(axes[0]);
+      axes[1] = glm::normalize(axes[1] - axes[0] * glm::dot(axes[0], axes[1]));
+      axes[2] = glm::cross(axes[0], axes[1]);
+      for (std::uint32_t v : mem) {
+        const glm::dvec3 n(normals[v]);
+        int best = 5;  // -axes[2] … ordering below; zero normals: +axes[2]
+        double bd = -2;
+        for (int k = 0; k < 6; ++k) {
+          const double d = (k < 3 ? 1.0 : -1.0) * glm::dot(n, axes[k % 3]);
+          if (d > bd + 1e-12) bd = d, best = k;
+        }
+        if (glm::dot(n, n) == 0) best = 2;
+        cluster[v] = static_cast<std::uint8_t>(best);
+      }
+      // Connected pieces of each direction.
+      for (std::uint32_t v : mem) {
+        if (vchart[v] != kNone) continue;
+        const int k = cluster[v];
+        ChartMap m;
+        m.kind = region[v] == Region::Sheet ? Chart::Kind::Sheet : Chart::Kind::Joint;
+        m.axis = (k < 3 ? 1.0 : -1.0) * axes[k % 3];
+        m.b1 = axes[(k + 1) % 3];
+        m.b2 = glm::cross(m.axis, m.b1);
+        const auto id = static_cast<std::uint32_t>(maps.size());
+        maps.push_back(m);
+        vchart[v] = id;
+        stack = {v};
+        while (!stack.empty()) {
+          const std::uint32_t a = stack.back();
+          stack.pop_back();
+          for (std::uint32_t q = adj_start[a]; q < adj_start[a + 1]; ++q) {
+            const std::uint32_t b = adj[q];
+            if (vchart[b] == kNone && comp[b] == ci && cluster[b] == k) vchart[b] = id, stack.push_back(b);
+          }
+        }
+      }
+    }
+  };
+
+  // Local corners of face f in chart c (model units), wrapping charts unwrapped toward the
+  // first corner that belongs to c (or corner 0).
+  const auto face_local = [&](std::size_t f, std::uint32_t c, glm::dvec2 (&uv)[3]) {
+    const Triangle& t = mesh.triangles[f];
+    int ref = 0;
+    for (int k = 0; k < 3; ++k) {
+      uv[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
+      if (vchart[t[k]] == c && vchart[t[ref]] != c) ref = k;
+    }
+    if (maps[c].kind == Chart::Kind::Bone && maps[c].width > 0) {
+      unwrap(uv, ref, maps[c].width);
+      // Keep the triangle overlapping [0, width): shift it whole when it fell outside.
+      const double w = maps[c].width;
+      const double xmax = std::max({uv[0].x, uv[1].x, uv[2].x}), xmin = std::min({uv[0].x, uv[1].x, uv[2].x});
+      const double shift = xmax <= 0 ? w : (xmin >= w ? -w : 0.0);
+      for (glm::dvec2& q : uv) q.x += shift;
+    }
+  };
+  const auto face_charts = [&](std::size_t f, std::uint32_t (&cs)[3]) {
+    int n = 0;
+    for (std::uint32_t v : mesh.triangles[f]) {
+      const std::uint32_t c = vchart[v];
+      if (std::find(cs, cs + n, c) == cs + n) cs[n++] = c;
+    }
+    return n;
+  };
+
+  // 4. Demote the vertices of stretched or flipped triangles in bone and cap charts.
+  for (int round = 0; round < 12; ++round) {
+    build_charts();
+    std::vector<std::uint8_t> demote(V, 0);
+    bool any = false;
+    for (std::size_t f = 0; f < F; ++f) {
+      const Triangle& t = mesh.triangles[f];
+      std::uint32_t cs[3];
+      const int nc = face_charts(f, cs);
+      for (int i = 0; i < nc; ++i) {
+        const ChartMap& m = maps[cs[i]];
+        if (m.kind != Chart::Kind::Bone && !m.cap) continue;
+        glm::dvec2 uv[3];
+        face_local(f, cs[i], uv);
+        const glm::dvec3 p0(mesh.positions[t[0]]), p1(mesh.positions[t[1]]), p2(mesh.positions[t[2]]);
+        const double model = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
+        const double local = std::max({glm::length(uv[1] - uv[0]), glm::length(uv[2] - uv[1]), glm::length(uv[0] - uv[2])});
+        int own = 0;
+        for (std::uint32_t v : t) own += vchart[v] == cs[i];
+        const double area3 = glm::length(glm::cross(p1 - p0, p2 - p0));
+        const bool flipped = own >= 2 && area3 > 1e-12 * model * model && signed_area2(uv[0], uv[1], uv[2]) <= 0;
+        if (local > options.max_stretch * model || flipped) {
+          for (std::uint32_t v : t)
+            if (vchart[v] == cs[i]) demote[v] = 1, any = true;
+        }
+      }
+    }
+    if (!any) break;
+    for (std::size_t v = 0; v < V; ++v)
+      if (demote[v]) region[v] = Region::Joint, owner[v] = kNone;
+    if (round == 11) build_charts();
+  }
+
+  // 5. Atlas triangles in local coordinates; chart extents.
+  struct LocalTri {
+    std::uint32_t chart, face;
+    glm::dvec2 uv[3];
+  };
+  std::vector<LocalTri> local;
+  local.reserve(F + F / 4);
+  for (std::size_t f = 0; f < F; ++f) {
+    std::uint32_t cs[3];
+    const int nc = face_charts(f, cs);
+    for (int i = 0; i < nc; ++i) {
+      LocalTri lt{cs[i], static_cast<std::uint32_t>(f), {}};
+      face_local(f, cs[i], lt.uv);
+      local.push_back(lt);
+      ChartMap& m = maps[cs[i]];
+      for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
+    }
+  }
+  std::vector<glm::dvec2> vlocal(V);
+  for (std::size_t v = 0; v < V; ++v) {
+    vlocal[v] = local_coords(maps[vchart[v]], B, glm::dvec3(mesh.positions[v]));
+    ChartMap& m = maps[vchart[v]];
+    m.lo = glm::min(m.lo, vlocal[v]);
+    m.hi = glm::max(m.hi, vlocal[v]);
+  }
+  for (ChartMap& m : maps)
+    if (m.kind == Chart::Kind::Bone) m.lo.x = 0, m.hi.x = m.width;
+
+  // 6. Scale and packing: the largest texels-per-unit at which the shelf packing fits.
+  const std::size_t C = maps.size();
+  double total = 0;
+  for (const ChartMap& m : maps) total += std::max(m.hi.x - m.lo.x, 0.0) * std::max(m.hi.y - m.lo.y, 0.0);
+  const auto sizes = [&](double tpu, std::vector<std::uint32_t>& w, std::vector<std::uint32_t>& h) {
+    w.resize(C);
+    h.resize(C);
+    for (std::size_t c = 0; c < C; ++c) {
+      const ChartMap& m = maps[c];
+      const double ex = (m.hi.x - m.lo.x) * tpu, ey = (m.hi.y - m.lo.y) * tpu;
+      const double cap = 1e9;
+      w[c] = m.kind == Chart::Kind::Bone ? static_cast<std::uint32_t>(std::max(3.0, std::min(cap, std::round(ex))))
+                                         : static_cast<std::uint32_t>(std::min(cap, std::ceil(ex)) + 1);
+      h[c] = static_cast<std::uint32_t>(std::min(cap, std::ceil(ey)) + 1);
+    }
+  };
+  const double size = options.atlas_size;
+  double hi_tpu = total > 0 ? size / std::sqrt(total) : size / std::max(diag, 1e-30);
+  double lo_tpu = 0;
+  std::vector<std::uint32_t> w, h;
+  sizes(lo_tpu, w, h);
+  Packed best = shelf_pack(w, h, options.atlas_size, options.gutter);
+  if (!best.fits)
+    throw InputError("skeleton texture mapping: " + std::to_string(C) + " charts do not fit a " +
+                     std::to_string(options.atlas_size) + "² atlas with a gutter of " + std::to_string(options.gutter) +
+                     " (use a larger atlas)");
+  for (int it = 0; it < 48; ++it) {
+    const double mid = (lo_tpu + hi_tpu) / 2;
+    sizes(mid, w, h);
+    Packed p = shelf_pack(w, h, options.atlas_size, options.gutter);
+    if (p.fits) lo_tpu = mid, best = std::move(p);
+    else hi_tpu = mid;
+  }
+  const double tpu = lo_tpu;
+
+  // 7. Texel coordinates.
+  Stm out;
+  AtlasMapping& am = out.mapping;
+  am.size = options.atlas_size;
+  am.gutter = options.gutter;
+  am.charts.resize(C);
+  for (std::size_t c = 0; c < C; ++c) {
+    Chart& ch = am.charts[c];
+    ch.kind = maps[c].kind;
+    ch.x0 = best.x[c];
+    ch.y0 = best.y[c];
+    ch.width = best.w[c];
+    ch.height = best.h[c];
+    ch.wraps_x = maps[c].kind == Chart::Kind::Bone;
+  }
+  const auto to_texel = [&](std::uint32_t c, const glm::dvec2& q) {
+    const ChartMap& m = maps[c];
+    const Chart& ch = am.charts[c];
+    double x;
+    if (ch.wraps_x) x = ch.x0 + (m.width > 0 ? q.x / m.width * ch.width : 0.5 * ch.width);
+    else x = ch.x0 + 0.5 + (q.x - m.lo.x) * tpu;
+    const double y = ch.y0 + 0.5 + (q.y - m.lo.y) * tpu;
+    return glm::vec2(static_cast<float>(x), static_cast<float>(y));
+  };
+  am.triangles.reserve(local.size());
+  for (const LocalTri& lt : local) {
+    AtlasTriangle at;
+    at.chart = lt.chart;
+    at.face = lt.face;
+    for (int k = 0; k < 3; ++k) at.uv[k] = to_texel(lt.chart, lt.uv[k]);
+    am.triangles.push_back(at);
+  }
+  am.vertex_chart = vchart;
+  am.vertex_uv.resize(V);
+  for (std::size_t v = 0; v < V; ++v) {
+    glm::vec2 q = to_texel(vchart[v], vlocal[v]);
+    const Chart& ch = am.charts[vchart[v]];
+    // Keep float rounding inside the rectangle.
+    q.x = std::clamp(q.x, static_cast<float>(ch.x0), std::nextafter(static_cast<float>(ch.x0 + ch.width), 0.0f));
+    q.y = std::clamp(q.y, static_cast<float>(ch.y0), std::nextafter(static_cast<float>(ch.y0 + ch.height), 0.0f));
+    am.vertex_uv[v] = q;
+  }
+
+  // 8. Quality.
+  StmQuality& ql = out.quality;
+  ql.charts.resize(C);
+  ql.texels_per_unit = tpu;
+  std::vector<std::vector<std::pair<double, double>>> area_d(C), angle_d(C);
+  std::vector<std::pair<double, double>> all_area, all_angle;
+  std::vector<double> texel_area(C, 0.0);
+  for (std::size_t v = 0; v < V; ++v) ++ql.charts[vchart[v]].vertices;
+  for (const AtlasTriangle& at : am.triangles) {
+    ChartQuality& cq = ql.charts[at.chart];
+    ++cq.triangles;
+    const Triangle& t = mesh.triangles[at.face];
+    if (vchart[t[0]] != at.chart || vchart[t[1]] != at.chart || vchart[t[2]] != at.chart) continue;
+    const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
+        e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
+    const double l1 = glm::length(e1);
+    const glm::dvec3 nrm = glm::cross(e1, e2);
+    const double a2 = glm::length(nrm);
+    if (!(l1 > 0) || !(a2 > 1e-12 * l1 * l1)) continue;
+    const glm::dvec3 X = e1 / l1, Y = glm::normalize(glm::cross(nrm, e1));
+    // Model triangle in its plane: P1 = (l1, 0), P2 = (e2·X, e2·Y); atlas in model units (÷ tpu).
+    const double p2x = glm::dot(e2, X), p2y = glm::dot(e2, Y);
+    const glm::dvec2 q1 = glm::dvec2(at.uv[1] - at.uv[0]) / tpu, q2 = glm::dvec2(at.uv[2] - at.uv[0]) / tpu;
+    // J [l1 p2x; 0 p2y] = [q1 q2]  →  J = [q1 q2] [1/l1, -p2x/(l1 p2y); 0, 1/p2y].
+    const double j00 = q1.x / l1, j10 = q1.y / l1;
+    const double j01 = (q2.x - q1.x * p2x / l1) / p2y, j11 = (q2.y - q1.y * p2x / l1) / p2y;
+    const auto [s1, s2] = singular_values(j00, j01, j10, j11);
+    const double area = a2 / 2;
+    cq.area += area;
+    texel_area[at.chart] += std::abs(signed_area2(at.uv[0], at.uv[1], at.uv[2])) / 2;
+    const double ad = s1 * s2, gd = std::min(kMaxAngleDistortion, s2 > 0 ? s1 / s2 : kMaxAngleDistortion);
+    area_d[at.chart].push_back({ad, area});
+    angle_d[at.chart].push_back({gd, area});
+    all_area.push_back({ad, area});
+    all_angle.push_back({gd, area});
+  }
+  double used = 0;
+  for (std::size_t c = 0; c < C; ++c) {
+    ChartQuality& cq = ql.charts[c];
+    Chart& ch = am.charts[c];
+    cq.kind = ch.kind;
+    cq.texels = std::uint64_t{ch.width} * ch.height;
+    used += static_cast<double>(cq.texels);
+    cq.area_distortion = weighted_stats(std::move(area_d[c]));
+    cq.angle_distortion = weighted_stats(std::move(angle_d[c]));
+    ch.texels_per_unit = static_cast<float>(cq.area > 0 && texel_area[c] > 0 ? std::sqrt(texel_area[c] / cq.area) : tpu);
+    (ch.kind == Chart::Kind::Bone ? ql.bone_charts : ch.kind == Chart::Kind::Joint ? ql.joint_charts : ql.sheet_charts)++;
+  }
+  std::size_t bone_vertices = 0;
+  for (std::size_t v = 0; v < V; ++v) bone_vertices += am.charts[vchart[v]].kind == Chart::Kind::Bone;
+  ql.bone_vertex_share = static_cast<double>(bone_vertices) / static_cast<double>(V);
+  ql.atlas_used = used / (size * size);
+  ql.duplicated_triangles = am.triangles.size() - F;
+  ql.area_distortion = weighted_stats(std::move(all_area));
+  ql.angle_distortion = weighted_stats(std::move(all_angle));
+  ql.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::vector<glm::vec2> normalized_vertex_uv(const AtlasMapping& mapping) {
+  std::vector<glm::vec2> uv(mapping.vertex_uv.size());
+  const float s = static_cast<float>(mapping.size);
+  for (std::size_t i = 0; i < uv.size(); ++i) uv[i] = mapping.vertex_uv[i] / s;
+  return uv;
+}
+
+}  // namespace sdfkit::diffusion

@@ -1,0 +1,117 @@
+#pragma once
+// Texture-space diffusion (the paper's section 4.1): a per-vertex field is rasterized into the
+// atlas of a mapping (atlas.hpp), blurred there by a Gaussian and read back per vertex, all on the
+// device through one render graph (passes/atlas_*.cpp):
+//
+//   atlas_raster  the AtlasTriangles, per-corner values, into an RG32F atlas (value, coverage 1),
+//                 each fragment clipped to its chart's rectangle (a triangle across the seam of a
+//                 wrapping chart is drawn once per side); copied into a texel buffer
+//   atlas_blur    a separable Gaussian as a cascade of three box filters per axis (six compute
+//                 passes), each box a running sum along a row or column of one chart: the work per
+//                 texel is the same at every radius. Rows of a wrapping chart wrap; outside its
+//                 rectangle a chart sees zeros, and both channels are blurred, so the value read
+//                 back is blur(value·coverage) / blur(coverage) (normalized convolution): nothing
+//                 from another chart, from the gutter or from uncovered texels ever comes in
+//   atlas_sample  per vertex, bilinear at vertex_uv inside the vertex's chart, normalized
+//   atlas_dilate  (only when the atlas itself is asked for) the normalized atlas, uncovered texels
+//                 and half the gutter around each chart filled from the nearest covered texel of the
+//                 same chart, for a texture consumer (TEXCOORD_1) and the PNG
+//
+// Scale: with `sigma` (model units) each chart blurs with sigma · texels_per_unit texels, so the
+// blur is a Gaussian of sigma on the surface wherever the mapping is isometric; with `radius_px`
+// every chart blurs with that many texels (the paper's Table 2). A Gaussian of sigma on the
+// surface is heat flow for time t = sigma² / 2 (tests/diffusion hold it to that).
+
+#include "sdfkit/core/mesh.hpp"
+#include "sdfkit/diffusion/atlas.hpp"
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace sdfkit::vk {
+class Context;
+}
+
+namespace sdfkit::diffusion {
+
+struct DiffuseOptions {
+  float radius_px = 0.0f;  // the Gaussian's standard deviation in atlas texels, every chart; or
+  float sigma = 0.0f;      // in model units, per chart sigma · texels_per_unit. Exactly one > 0.
+  bool keep_atlas = false; // also return the dilated, normalized atlas (DiffuseResult::atlas)
+  bool profile = false;    // per-pass device times (DiffuseResult::timings)
+  // false: the graph without the blur passes (raster, sample): the benchmark's baseline, so the
+  // blur's cost is the difference of two wall times (lavapipe's per-pass timestamps are not
+  // reliable: it bins draws and rasterizes them later). The values are then meaningless.
+  bool blur = true;
+};
+
+// Where the time went (milliseconds). Device times only with DiffuseOptions::profile.
+struct DiffuseTimings {
+  double prepare = 0.0;   // host: triangle soup, chart table and line jobs written to upload memory
+  double raster = 0.0;    // device: atlas_raster (+ its copy into the texel buffer)
+  double blur = 0.0;      // device: the six box passes
+  double sample = 0.0;    // device: atlas_sample (+ atlas_dilate when asked)
+  double execute = 0.0;   // host wall time of the graph's submission, all passes
+  double readback = 0.0;  // host: values (and atlas) out of mapped memory
+  double total = 0.0;     // host wall time of diffuse()
+};
+
+// The blur's plan, on the host: three box radii per chart (texels) whose cascade has the
+// Gaussian's variance, and the work the six passes do. Independent of any device. With sigma in
+// model units and `mean_edge` > 0 (the mesh's mean edge length), the variance the linear
+// interpolation over triangles contributes (mean edge² / 4 per axis, see diffuse.cpp) is taken off the blur's.
+struct BlurPlan {
+  std::vector<std::array<std::uint32_t, 3>> radii;  // per chart
+  std::uint32_t dispatches = 0;    // compute dispatches of the blur (always 6)
+  std::uint64_t line_jobs = 0;     // rows + columns, each pass
+  std::uint64_t texel_reads = 0;   // over the six passes: every texel twice per pass + window warm-up
+};
+BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge = 0.0f);
+
+// Three box radii (texels) whose cascade has variance sigma_px² (within the rounding of integer
+// boxes: Kovesi's mix of two odd widths). sigma_px <= 0 gives {0, 0, 0}.
+std::array<std::uint32_t, 3> box_radii(float sigma_px);
+
+struct DiffuseResult {
+  std::vector<float> values;  // per vertex
+  std::vector<float> atlas;   // size × size, row y at [y * size], NaN where no chart reaches (keep_atlas)
+  DiffuseTimings timings;
+  BlurPlan plan;
+};
+
+// Checks that `mapping` fits `mesh` (sizes, chart indices, rectangles inside the atlas and apart,
+// uv inside their charts). Throws InputError with the first problem.
+void validate_mapping(const Mesh& mesh, const AtlasMapping& mapping);
+
+// Keeps the device pipelines and the graph's transient images between calls.
+class Diffuser {
+public:
+  explicit Diffuser(vk::Context& ctx);
+  ~Diffuser();
+  Diffuser(const Diffuser&) = delete;
+  Diffuser& operator=(const Diffuser&) = delete;
+
+  // `vertex_values`: one finite value per mesh vertex. Throws InputError on a bad mapping or
+  // options, DeviceError when the atlas is larger than the device allows.
+  DiffuseResult run(const Mesh& mesh, const AtlasMapping& mapping, std::span<const float> vertex_values,
+                    const DiffuseOptions& options);
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// One-shot: a Diffuser for this call only.
+std::vector<float> diffuse(vk::Context& ctx, const Mesh& mesh, const AtlasMapping& mapping,
+                           std::span<const float> vertex_values, const DiffuseOptions& options);
+
+// The k-ring smoothing comparable to a Gaussian of sigma (model units): engine/post/smooth puts
+// its K-th ring near two sigma (sigma = K · mean edge / 2), so K = ceil(2 sigma / mean edge),
+// at least 1. What `compare` and the tests set k-ring against.
+int kring_for_sigma(float sigma, float mean_edge);
+
+}  // namespace sdfkit::diffusion

@@ -1,0 +1,112 @@
+#pragma once
+// Skeleton texture mapping (STM, Madaras & Ďurikovič; the paper's section 4.1): a texture atlas
+// of a closed mesh built from its skeleton, for diffusing per-vertex fields in texture space.
+//
+//   mesh + skeleton ──build_stm()──▶ AtlasMapping (charts packed in one square atlas, a chart and
+//                                     atlas position per vertex, the triangles to rasterize)
+//                                     + StmQuality (distortion per chart, atlas share used)
+//
+// Charts (engine/diffusion/README.md has the details):
+//  - Bone: one per skeleton segment between joints (a chain of curve nodes of degree 2 between
+//    nodes of degree != 2). A vertex is parameterized by its closest point on the segment's
+//    polyline: y = arc length, x = angle around the polyline in a rotation-minimizing frame,
+//    scaled by the median distance of the chart's vertices to the polyline (x wraps).
+//  - Joint: at a leaf (end cap: azimuthal equidistant projection around the bone's direction)
+//    and, as planar projections, at junctions and wherever a bone chart would fold (closest point
+//    at a segment's end, surface normal along the bone, vertex on the polyline, a stretched or
+//    flipped triangle).
+//  - Sheet: vertices of sheet nodes, parameterized by planar projection of their own triangles.
+// Planar regions are split by normal direction (six directions of the region's principal axes)
+// into connected charts, so that no triangle of a chart flips.
+// Every chart's rectangle is sized from the surface it carries, at one scale (texels per model
+// unit) for the whole atlas, and shelf-packed into the atlas with the gutter.
+//
+// Wrapping (the contract in atlas.hpp): in a chart with wraps_x, an AtlasTriangle whose corners
+// straddle the angle seam has its corner x unwrapped by ±width so the triangle is contiguous; its
+// x may then leave [x0, x0 + width) by less than width on one side, and a rasterizer draws it at
+// x and at x ∓ width, clipped to the rectangle (write_atlas_png does). Every other corner, and
+// every vertex_uv, lies inside its chart's rectangle.
+
+#include "sdfkit/core/mesh.hpp"
+#include "sdfkit/diffusion/atlas.hpp"
+#include "sdfkit/skeleton/skeleton.hpp"
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace sdfkit::diffusion {
+
+struct StmOptions {
+  std::uint32_t atlas_size = 2048;  // the atlas is atlas_size² texels (16 … 16384)
+  std::uint32_t gutter = 2;         // texels between rectangles and around the atlas (0 … 64)
+  // A vertex stays in a bone chart only while its normal is within this angle of perpendicular
+  // to the bone (|n·t| ≤ cos(max_normal_angle_deg)): ends and crotches go to joint charts
+  // where the cylinder map would fold.
+  double max_normal_angle_deg = 50.0;
+  // An atlas triangle whose longest edge is over this factor times its model length × the
+  // atlas scale is stretched: its vertices in that chart move to a planar joint chart.
+  double max_stretch = 3.0;
+};
+
+// Statistics of a distribution over the triangles of a chart, weighted by surface area.
+struct Stats {
+  double mean = 0, p95 = 0, max = 0;
+};
+
+struct ChartQuality {
+  Chart::Kind kind = Chart::Kind::Bone;
+  std::uint32_t vertices = 0;    // vertices assigned to the chart
+  std::uint32_t triangles = 0;   // atlas triangles in the chart (own and duplicated)
+  double area = 0;               // model area of the faces whose corners are all in the chart
+  std::uint64_t texels = 0;      // width × height of the rectangle
+  // Per triangle, from the singular values σ1 ≥ σ2 of the map model surface → atlas, in units of
+  // the atlas scale (texels_per_unit of the whole atlas): area distortion σ1σ2 (1 = the same
+  // texel density everywhere) and angle distortion σ1/σ2 (1 = conformal). Over the faces whose
+  // corners are all in the chart. Angle distortion is capped at 1000 (a triangle mapped to a
+  // segment).
+  Stats area_distortion, angle_distortion;
+};
+
+struct StmQuality {
+  std::vector<ChartQuality> charts;
+  double atlas_used = 0;           // share of the atlas inside chart rectangles
+  double texels_per_unit = 0;      // the atlas scale: texels per model unit
+  std::uint32_t bone_charts = 0, joint_charts = 0, sheet_charts = 0;
+  double bone_vertex_share = 0;    // share of vertices in bone charts
+  std::uint64_t duplicated_triangles = 0;  // atlas triangles beyond one per face
+  // The same statistics over every chart's faces together (area weighted).
+  Stats area_distortion, angle_distortion;
+  double seconds = 0;              // wall-clock time of build_stm
+};
+
+struct Stm {
+  AtlasMapping mapping;
+  StmQuality quality;
+};
+
+// Builds the mapping of `mesh` (V positions, F triangles; closed or not) from `skeleton` (its
+// nodes' `vertices` index mesh vertices: skeleton::extract on this mesh, or read_skeleton_json
+// of what `sdfkit skeleton` wrote for it). A vertex no node holds takes a neighbour's node.
+// Deterministic. Throws InputError for an empty mesh, a skeleton without nodes, a node vertex
+// out of range, or options out of range.
+Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skeleton, const StmOptions& options = {});
+
+// Reads a skeleton JSON as written by `sdfkit skeleton` / skeleton::to_json (nodes with position,
+// radius, sheet, vertices; edges; sheet_triangles). Throws InputError "<path>: <problem>".
+skeleton::Skeleton read_skeleton_json(const std::string& path);
+skeleton::Skeleton parse_skeleton_json(const std::string& text, const std::string& what);
+
+// Figure 10: the atlas as an RGB PNG of mapping.size² pixels (y up: row 0 of the image is the
+// atlas's top row), every atlas triangle rasterized with the per-vertex values (V entries)
+// interpolated and coloured by io::colormap over their [min, max]; gutters and unused texels
+// dark. Written atomically. Throws InputError when vertex_values does not fit the mesh.
+void write_atlas_png(const AtlasMapping& mapping, const Mesh& mesh, std::span<const float> vertex_values,
+                     const std::string& path);
+
+// The mapping as one per-vertex UV set in [0,1]² (atlas texels / size, v = 0 at the atlas's
+// bottom row as in atlas.hpp; glTF flips v when writing TEXCOORD_1): vertex_uv / size.
+std::vector<glm::vec2> normalized_vertex_uv(const AtlasMapping& mapping);
+
+}  // namespace sdfkit::diffusion

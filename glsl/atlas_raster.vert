@@ -1,0 +1,19 @@
+#version 450
+// Atlas raster, vertex stage: an atlas triangle's corner (texel coordinates) to clip space over
+// the whole atlas; texel (x, y) covers [x, x+1) x [y, y+1), framebuffer row y = atlas row y.
+layout(location = 0) in vec2 in_uv;
+layout(location = 1) in float in_value;
+layout(location = 2) in uint in_chart;
+
+layout(push_constant) uniform Push {
+  vec4 scale;  // x: 2 / atlas size
+} pc;
+
+layout(location = 0) out float out_value;
+layout(location = 1) flat out uint out_chart;
+
+void main() {
+  gl_Position = vec4(in_uv * pc.scale.x - 1.0, 0.0, 1.0);
+  out_value = in_value;
+  out_chart = in_chart;
+}

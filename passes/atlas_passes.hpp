@@ -1,0 +1,101 @@
+#pragma once
+// The texture-space diffusion's render-graph passes (sdfkit::diffusion::Diffuser), one file each:
+// atlas_raster.cpp, atlas_blur.cpp, atlas_sample.cpp, atlas_dilate.cpp. Like the other passes
+// they take handles, declare their uses, bind through what they declared and return the handles
+// they wrote. The push-constant structs mirror the GLSL blocks (tests/vulkan/push_constants_test).
+
+#include "sdfkit/vulkan/pipeline.hpp"
+#include "sdfkit/vulkan/render_graph.hpp"
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace sdfkit::diffusion::passes {
+
+// One chart as the shaders see it (std430): rect = x0, y0, width, height (texels);
+// params = the three box radii of the blur, wraps_x.
+struct GpuChart {
+  glm::uvec4 rect;
+  glm::uvec4 params;
+};
+static_assert(sizeof(GpuChart) == 32);
+
+// One corner of a rasterized atlas triangle (atlas_raster.vert's vertex input).
+struct RasterVertex {
+  glm::vec2 uv;        // atlas texels
+  float value;
+  std::uint32_t chart; // fragments outside this chart's rectangle are discarded
+};
+static_assert(sizeof(RasterVertex) == 16);
+
+// One vertex to read back (atlas_sample.comp).
+struct SampleQuery {
+  glm::vec2 uv;        // atlas texels
+  std::uint32_t chart;
+  float fallback;      // returned when no covered texel reaches the vertex
+};
+static_assert(sizeof(SampleQuery) == 16);
+
+struct RasterPush {  // atlas_raster.vert
+  glm::vec4 scale;   // x: 2 / atlas size
+};
+struct BlurPush {    // atlas_blur.comp
+  std::uint32_t job_offset, job_count, size, axis, box, src_tiled;
+};
+
+// Bytes of a tiled texel buffer (glsl/atlas_common.glsl: 64² tiles of vec2) of a size² atlas.
+inline std::uint64_t tiled_texel_bytes(std::uint32_t size) {
+  const std::uint64_t tiles = (size + 63u) / 64u;
+  return tiles * tiles * 64u * 64u * 8u;
+}
+struct SamplePush {  // atlas_sample.comp
+  std::uint32_t vertex_count, size;
+};
+struct DilatePush {  // atlas_dilate.comp
+  std::uint32_t chart, size, reach, margin;
+};
+
+// Rasterizes `vertex_count` RasterVertex corners into `target` (RG32F, cleared to 0: value,
+// coverage) and copies it into `texels` (size² vec2). Returns the written texel buffer.
+struct AtlasRasterPass {
+  const vk::Pipeline* pipeline = nullptr;
+  vk::ImageHandle target;
+  vk::BufferHandle vertices, charts, texels;
+  std::uint32_t vertex_count = 0, size = 0;
+};
+vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& pass);
+
+// The separable box cascade: three boxes along x (rows, `row_jobs` uvec2 jobs from offset 0),
+// then three along y (`column_jobs` from offset row_jobs), ping-ponging between `texels` (read
+// row-major by the first pass) and `scratch`, both tiled_texel_bytes. Returns the blurred, tiled
+// texel buffer (a version of `texels`).
+struct AtlasBlurPass {
+  const vk::Pipeline* pipeline = nullptr;
+  vk::BufferHandle texels, scratch, charts, jobs;
+  std::uint32_t row_jobs = 0, column_jobs = 0, size = 0;
+};
+vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& pass);
+inline constexpr std::uint32_t kBlurDispatches = 6;
+
+// Per vertex: the normalized bilinear read of the blurred texels. Returns the written `values`.
+struct AtlasSamplePass {
+  const vk::Pipeline* pipeline = nullptr;
+  vk::BufferHandle texels, charts, queries, values;
+  std::uint32_t vertex_count = 0, size = 0;
+};
+vk::BufferHandle add_atlas_sample_pass(vk::RenderGraph& graph, const AtlasSamplePass& pass);
+
+// The normalized atlas (size² floats, NaN outside every chart's reach): each chart's rectangle
+// and `margin` texels around it, uncovered texels from the nearest covered one within `reach`.
+struct AtlasDilatePass {
+  const vk::Pipeline* pipeline = nullptr;
+  vk::BufferHandle texels, charts, atlas;
+  std::uint32_t chart_count = 0, size = 0, reach = 4, margin = 1;
+  const std::vector<GpuChart>* charts_host = nullptr;  // rectangles, for the dispatch sizes
+};
+vk::BufferHandle add_atlas_dilate_pass(vk::RenderGraph& graph, const AtlasDilatePass& pass);
+
+}  // namespace sdfkit::diffusion::passes

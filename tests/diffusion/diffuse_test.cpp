@@ -1,0 +1,313 @@
+// Texture-space diffusion (issue 13) on lavapipe with validation on: the blur alone (constant
+// fields stay, nothing leaks between charts, rows of cylindrical charts wrap, the work does not
+// grow with the radius), and the whole diffusion against intrinsic heat diffusion and k-ring
+// smoothing, and across chart seams.
+
+#include "../vulkan/vk_test_util.hpp"
+#include "diffuse_test_util.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/diffusion/diffuse.hpp"
+#include "sdfkit/diffusion/stm.hpp"
+#include "sdfkit/io/asset.hpp"
+#include "sdfkit/skeleton/skeleton.hpp"
+#include "analytic.hpp"
+#include "sdfkit/post/compare.hpp"
+#include "sdfkit/post/smooth.hpp"
+
+#include <random>
+
+namespace sdfkit::diffusion {
+namespace {
+
+class Diffuse : public ::testing::Test {
+protected:
+  void SetUp() override {
+    ctx_ = test::make_test_context();
+    if (!ctx_) GTEST_SKIP() << "no Vulkan device";
+    diffuser_ = std::make_unique<Diffuser>(*ctx_);
+  }
+  void TearDown() override {
+    if (ctx_) {
+      SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(*ctx_);
+    }
+  }
+  std::unique_ptr<vk::Context> ctx_;
+  std::unique_ptr<Diffuser> diffuser_;
+};
+
+// A field with a step, a smooth part and noise, positive like an SDF.
+std::vector<float> test_field(const Mesh& m, unsigned seed = 7) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, 0.15f);
+  std::vector<float> u(m.vertex_count());
+  for (std::size_t v = 0; v < u.size(); ++v) {
+    const glm::vec3 p = m.positions[v];
+    u[v] = 2.0f + (p.z > 2.0f ? 0.8f : 0.0f) + 0.4f * std::sin(3.0f * std::atan2(p.y, p.x)) + noise(rng);
+  }
+  return u;
+}
+
+DiffuseOptions sigma_of(float sigma, bool keep_atlas = false) {
+  DiffuseOptions o;
+  o.sigma = sigma;
+  o.keep_atlas = keep_atlas;
+  return o;
+}
+
+TEST(DiffusePlan, BoxCascadeHasTheGaussiansVariance) {
+  for (float s : {1.0f, 2.0f, 3.7f, 8.0f, 16.0f, 32.0f, 64.0f}) {
+    const auto r = box_radii(s);
+    double var = 0.0;
+    for (std::uint32_t x : r) var += ((2.0 * x + 1) * (2.0 * x + 1) - 1.0) / 12.0;
+    EXPECT_NEAR(std::sqrt(var), s, 0.08 * s + 0.3) << "sigma " << s;
+  }
+  EXPECT_EQ(box_radii(0.0f), (std::array<std::uint32_t, 3>{0, 0, 0}));
+}
+
+// The blur's work (reads per pass, dispatches) on a 2048² atlas: radius 64 costs what radius 2
+// costs (the running sums read each texel twice whatever the radius; only the window's warm-up
+// grows).
+TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
+  AtlasMapping a;
+  a.size = 2048;
+  a.charts.push_back({Chart::Kind::Bone, 2, 2, 2044, 2044, true, 10.0f});
+  DiffuseOptions r2, r64;
+  r2.radius_px = 2.0f;
+  r64.radius_px = 64.0f;
+  const BlurPlan p2 = plan_blur(a, r2), p64 = plan_blur(a, r64);
+  EXPECT_EQ(p2.dispatches, 6u);
+  EXPECT_EQ(p64.dispatches, p2.dispatches);
+  EXPECT_EQ(p64.line_jobs, p2.line_jobs);
+  EXPECT_LE(static_cast<double>(p64.texel_reads), 1.1 * static_cast<double>(p2.texel_reads));
+  EXPECT_GE(p64.radii[0][0], 30u);
+}
+
+TEST(DiffusePlan, KRingForSigmaPutsTheLastRingNearTwoSigma) {
+  EXPECT_EQ(kring_for_sigma(0.5f, 1.0f), 1);
+  EXPECT_EQ(kring_for_sigma(1.0f, 1.0f), 2);
+  EXPECT_EQ(kring_for_sigma(2.5f, 1.0f), 5);
+  EXPECT_EQ(kring_for_sigma(3.0f, 1.0f), 6);
+}
+
+TEST_F(Diffuse, BadOptionsAndMappingsAreInputErrors) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const AtlasMapping a = test::cylinder_wrapping_mapping(m, g, 512);
+  const std::vector<float> u(m.vertex_count(), 1.0f);
+  EXPECT_THROW(diffuser_->run(m, a, u, {}), InputError);  // neither radius nor sigma
+  DiffuseOptions both;
+  both.radius_px = 2.0f;
+  both.sigma = 0.1f;
+  EXPECT_THROW(diffuser_->run(m, a, u, both), InputError);
+  AtlasMapping bad = a;
+  bad.charts[0].width = 600;  // leaves the atlas
+  EXPECT_THROW(diffuser_->run(m, bad, u, sigma_of(0.1f)), InputError);
+  bad = a;
+  bad.vertex_chart[3] = 5;
+  EXPECT_THROW(diffuser_->run(m, bad, u, sigma_of(0.1f)), InputError);
+  bad = a;
+  bad.vertex_uv.pop_back();
+  EXPECT_THROW(diffuser_->run(m, bad, u, sigma_of(0.1f)), InputError);
+  std::vector<float> nan = u;
+  nan[1] = std::nanf("");
+  EXPECT_THROW(diffuser_->run(m, a, nan, sigma_of(0.1f)), InputError);
+}
+
+TEST_F(Diffuse, ConstantFieldStaysConstant) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  for (const AtlasMapping& a : {test::cylinder_wrapping_mapping(m, g, 512), test::cylinder_split_mapping(m, g, 1024, 4, 4)}) {
+    const std::vector<float> u(m.vertex_count(), 3.25f);
+    for (float sigma : {0.05f, 0.5f}) {
+      const DiffuseResult r = diffuser_->run(m, a, u, sigma_of(sigma, true));
+      for (float x : r.values) ASSERT_NEAR(x, 3.25f, 1e-4f);
+      std::size_t filled = 0;
+      for (float x : r.atlas)
+        if (!std::isnan(x)) {
+          ASSERT_NEAR(x, 3.25f, 1e-4f);
+          ++filled;
+        }
+      std::size_t chart_texels = 0;
+      for (const Chart& c : a.charts) chart_texels += std::size_t{c.width} * c.height;
+      EXPECT_GE(filled, chart_texels);  // every chart texel (and the half gutters) filled
+    }
+  }
+}
+
+// Values of one chart never reach another: the cylinder in four charts, every vertex whose
+// triangles all lie in chart 0 alone at 1000, the rest 0; at radius 64 texels every texel and
+// vertex of the other charts stays exactly 0.
+TEST_F(Diffuse, NothingLeaksIntoAnotherChart) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const AtlasMapping a = test::cylinder_split_mapping(m, g, 1024, 4, 0);
+  std::vector<int> only0(m.vertex_count(), 1);
+  for (const AtlasTriangle& t : a.triangles)
+    if (t.chart != 0)
+      for (std::uint32_t v : m.triangles[t.face]) only0[v] = 0;
+  std::vector<float> u(m.vertex_count(), 0.0f);
+  std::size_t hot = 0;
+  for (std::size_t v = 0; v < u.size(); ++v)
+    if (only0[v]) {
+      u[v] = 1000.0f;
+      ++hot;
+    }
+  ASSERT_GT(hot, 100u);
+  DiffuseOptions o;
+  o.radius_px = 64.0f;
+  o.keep_atlas = true;
+  const DiffuseResult r = diffuser_->run(m, a, u, o);
+  for (std::size_t c = 1; c < a.charts.size(); ++c) {
+    const Chart& ch = a.charts[c];
+    for (std::uint32_t y = ch.y0; y < ch.y0 + ch.height; ++y)
+      for (std::uint32_t x = ch.x0; x < ch.x0 + ch.width; ++x)
+        ASSERT_EQ(r.atlas[std::size_t{y} * a.size + x], 0.0f) << "chart " << c << " texel " << x << "," << y;
+  }
+  float max0 = 0.0f;
+  for (std::size_t v = 0; v < u.size(); ++v) {
+    if (a.vertex_chart[v] != 0) {
+      ASSERT_EQ(r.values[v], 0.0f) << "vertex " << v << " of chart " << a.vertex_chart[v];
+    } else {
+      max0 = std::max(max0, r.values[v]);
+    }
+  }
+  EXPECT_GT(max0, 100.0f);  // chart 0 itself got the heat
+}
+
+// A cylindrical chart wraps: a ridge of values on the seam column blurs symmetrically to both
+// sides of the seam, as it does away from the seam; without wrapping it would not.
+TEST_F(Diffuse, CylindricalChartsWrap) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const AtlasMapping a = test::cylinder_wrapping_mapping(m, g, 512);
+  const auto run = [&](int column) {
+    std::vector<float> u(m.vertex_count(), 1.0f);
+    for (std::size_t v = 0; v < u.size(); ++v)
+      if (static_cast<int>(v) % g.segments == column) u[v] = 10.0f;
+    DiffuseOptions o;
+    o.radius_px = 8.0f;  // two columns
+    return diffuser_->run(m, a, u, o).values;
+  };
+  const std::vector<float> seam = run(0), middle = run(32);
+  const int j = g.stacks / 2;
+  const auto at = [&](const std::vector<float>& u, int i) {
+    return u[static_cast<std::size_t>(j * g.segments + ((i % g.segments) + g.segments) % g.segments)];
+  };
+  for (int d = 1; d <= 3; ++d) {
+    EXPECT_NEAR(at(seam, -d), at(seam, d), 1e-3f * at(seam, d)) << d;     // symmetric across the seam
+    EXPECT_NEAR(at(seam, -d), at(middle, 32 - d), 1e-3f * at(seam, d)) << d;  // as in the middle
+    EXPECT_GT(at(seam, -d), 1.05f);
+  }
+}
+
+struct Agreement {
+  double pearson = 0, median_rel = 0, rms = 0;
+};
+Agreement agreement(std::span<const float> a, std::span<const float> heat) {
+  Agreement r;
+  const FieldComparison c = compare_fields(a, heat);
+  r.pearson = c.pearson;
+  r.median_rel = c.median_relative;
+  r.rms = test::rms_difference(a, heat);
+  return r;
+}
+
+// Against intrinsic heat diffusion (t = sigma² / 2) on an isometrically mapped cylinder, sigma 1
+// to 5 mean edge lengths: Pearson >= 0.95, median relative difference <= 5 %, and no further from
+// heat diffusion (RMS) than k-ring smoothing at the same sigma.
+TEST_F(Diffuse, MatchesHeatDiffusionOnACylinder) {
+  test::CylinderGrid g;
+  g.texels_per_column = 8;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const AtlasMapping a = test::cylinder_wrapping_mapping(m, g, 1024);
+  const std::vector<float> u = test_field(m);
+  const float edge = mean_edge_length(m);
+  for (float edges : {1.0f, 2.0f, 3.0f, 5.0f}) {
+    const float sigma = edges * edge;
+    const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
+    const std::vector<float> tex = diffuser_->run(m, a, u, sigma_of(sigma)).values;
+    SmoothOptions so;
+    so.sigma = sigma;
+    so.rings = kring_for_sigma(sigma, edge);
+    const std::vector<float> kring = smooth_field(m, SdfDomain::Vertex, u, so);
+    const Agreement t = agreement(tex, heat), k = agreement(kring, heat);
+    EXPECT_GE(t.pearson, 0.95) << edges << " edges";
+    EXPECT_LE(t.median_rel, 0.05) << edges << " edges";
+    EXPECT_LE(t.rms, k.rms * 1.0 + 1e-6) << edges << " edges: texture " << t.rms << ", k-ring " << k.rms;
+    std::printf("sigma %.0f edges: texture pearson %.4f median %.4f rms %.4f | k-ring (k=%d) pearson %.4f median %.4f rms %.4f\n",
+                edges, t.pearson, t.median_rel, t.rms, so.rings, k.pearson, k.median_rel, k.rms);
+    RecordProperty("pearson_" + std::to_string(static_cast<int>(edges)), std::to_string(t.pearson));
+  }
+}
+
+// No seams: across the borders of four non-wrapping charts (each carrying three sigma of its
+// neighbours' triangles) the value jump per unit length at the 95th percentile is at most 1.5
+// times the jump across edges inside charts, and the result still matches heat diffusion.
+TEST_F(Diffuse, NoSeamsAcrossChartBorders) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const float edge = mean_edge_length(m);
+  const std::vector<float> u = test_field(m, 11);
+  for (float edges : {1.0f, 2.0f}) {
+    const float sigma = edges * edge;
+    const int overlap = static_cast<int>(std::ceil(3.0f * sigma / (2.0f * std::numbers::pi_v<float> * g.r / g.segments)));
+    const AtlasMapping a = test::cylinder_split_mapping(m, g, 1024, 4, overlap);
+    const std::vector<float> tex = diffuser_->run(m, a, u, sigma_of(sigma)).values;
+    const test::SeamJumps s = test::seam_jumps(m, a, tex);
+    ASSERT_FALSE(s.border.empty());
+    const double ratio = test::quantile(s.border, 0.95) / test::quantile(s.inside, 0.95);
+    EXPECT_LE(ratio, 1.5) << edges << " edges";
+    const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
+    EXPECT_GE(compare_fields(tex, heat).pearson, 0.95) << edges << " edges";
+  }
+}
+
+}  // namespace
+}  // namespace sdfkit::diffusion
+
+namespace sdfkit::diffusion {
+namespace {
+
+// A real mesh through the real mapping: CGAL's camel, its skeleton extracted from the geometry
+// (no SDF backend) and build_stm's atlas (210 charts). Against heat diffusion at 1..5 mean edges:
+// Pearson >= 0.95 and median relative difference <= 5 % hold (measured 0.995..0.999 and
+// 0.4..1.4 %). What does not hold yet, printed and not asserted: the RMS difference is 1.1..1.8x
+// k-ring's, and the seam ratio (P95 jump across chart borders / inside charts) is 4..21, because
+// build_stm's charts carry only one ring of their neighbours' triangles, and a chart never sees
+// another's texels: seamless diffusion needs charts that overlap by about 3 sigma (as the split
+// cylinder of NoSeamsAcrossChartBorders does).
+TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
+  const Mesh m = io::load_asset(test::data_mesh("camel.off")).mesh;
+  const Stm stm = build_stm(m, skeleton::extract(m, nullptr, {}, {}));
+  const AtlasMapping& a = stm.mapping;
+  const Aabb box = bounding_box(m.positions);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.05f);
+  std::vector<float> u(m.vertex_count());
+  for (std::size_t v = 0; v < u.size(); ++v) {
+    const glm::vec3 p = (m.positions[v] - box.min) / box.diagonal();
+    u[v] = 1.0f + 0.5f * std::sin(6.0f * p.x) * std::cos(5.0f * p.y) + noise(rng);
+  }
+  const float edge = mean_edge_length(m);
+  for (float edges : {1.0f, 2.0f, 3.0f, 5.0f}) {
+    const float sigma = edges * edge;
+    const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
+    const std::vector<float> tex = diffuser_->run(m, a, u, sigma_of(sigma)).values;
+    SmoothOptions so;
+    so.sigma = sigma;
+    so.rings = kring_for_sigma(sigma, edge);
+    const std::vector<float> kring = smooth_field(m, SdfDomain::Vertex, u, so);
+    const Agreement t = agreement(tex, heat), k = agreement(kring, heat);
+    const test::SeamJumps s = test::seam_jumps(m, a, tex);
+    const double ratio = test::quantile(s.border, 0.95) / test::quantile(s.inside, 0.95);
+    EXPECT_GE(t.pearson, 0.95) << edges << " edges";
+    EXPECT_LE(t.median_rel, 0.05) << edges << " edges";
+    std::printf("camel sigma %.0f edges (%zu charts): texture pearson %.4f median %.4f rms %.4f seam ratio %.2f | "
+                "k-ring (k=%d) pearson %.4f median %.4f rms %.4f\n",
+                edges, a.charts.size(), t.pearson, t.median_rel, t.rms, ratio, so.rings, k.pearson, k.median_rel, k.rms);
+  }
+}
+
+}  // namespace
+}  // namespace sdfkit::diffusion

@@ -1,0 +1,222 @@
+#pragma once
+// Test-side tools for texture-space diffusion: intrinsic heat diffusion (cotangent Laplacian,
+// lumped mass, one implicit step; Eigen, tests only), analytic shapes with mappings built by
+// hand (a cylinder as one wrapping chart or as overlapping non-wrapping charts, a box as one chart
+// per side), and the seam statistic.
+
+#include "sdfkit/core/mesh.hpp"
+#include "sdfkit/diffusion/atlas.hpp"
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace sdfkit::test {
+
+// Heat flow for time t = sigma² / 2 (the Gaussian of sigma): `steps` implicit steps
+// (M + (t / steps) L) u_{k+1} = M u_k, L the cotangent Laplacian (positive semi-definite), M the
+// lumped (barycentric) mass. One step is the resolvent (1 + t Δ)^-1, whose kernel has the
+// Gaussian's variance but a sharper peak and heavier tails; more steps converge to heat flow.
+inline std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> u0, double sigma, int steps = 8) {
+  const auto V = static_cast<int>(mesh.vertex_count());
+  std::vector<Eigen::Triplet<double>> trip;
+  std::vector<double> mass(static_cast<std::size_t>(V), 0.0);
+  for (const auto& tri : mesh.triangles) {
+    const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[tri[0]]), glm::dvec3(mesh.positions[tri[1]]),
+                             glm::dvec3(mesh.positions[tri[2]])};
+    const double area = 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+    if (!(area > 0.0)) continue;
+    for (int k = 0; k < 3; ++k) {
+      mass[tri[static_cast<std::size_t>(k)]] += area / 3.0;
+      const int i = static_cast<int>(tri[static_cast<std::size_t>((k + 1) % 3)]);
+      const int j = static_cast<int>(tri[static_cast<std::size_t>((k + 2) % 3)]);
+      const glm::dvec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
+      const double w = 0.5 * glm::dot(a, b) / glm::length(glm::cross(a, b));  // cot of the angle at k, halved
+      trip.emplace_back(i, j, -w);
+      trip.emplace_back(j, i, -w);
+      trip.emplace_back(i, i, w);
+      trip.emplace_back(j, j, w);
+    }
+  }
+  const double t = 0.5 * sigma * sigma / steps;
+  Eigen::SparseMatrix<double> A(V, V);
+  for (auto& e : trip) e = Eigen::Triplet<double>(e.row(), e.col(), t * e.value());
+  for (int v = 0; v < V; ++v) trip.emplace_back(v, v, mass[static_cast<std::size_t>(v)]);
+  A.setFromTriplets(trip.begin(), trip.end());
+  Eigen::VectorXd u(V);
+  for (int v = 0; v < V; ++v) u[v] = u0[static_cast<std::size_t>(v)];
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
+  for (int k = 0; k < steps; ++k) {
+    Eigen::VectorXd rhs(V);
+    for (int v = 0; v < V; ++v) rhs[v] = mass[static_cast<std::size_t>(v)] * u[v];
+    u = solver.solve(rhs);
+  }
+  std::vector<float> out(static_cast<std::size_t>(V));
+  for (int v = 0; v < V; ++v) out[static_cast<std::size_t>(v)] = static_cast<float>(u[v]);
+  return out;
+}
+
+// An open cylinder of radius r and height h around z: `segments` columns around (vertex
+// (i, j) = j * segments + i at angle 2 pi i / segments, height j * h / stacks).
+inline Mesh open_cylinder(float r, float h, int segments, int stacks) {
+  Mesh m;
+  for (int j = 0; j <= stacks; ++j)
+    for (int i = 0; i < segments; ++i) {
+      const float a = 2.0f * std::numbers::pi_v<float> * static_cast<float>(i) / static_cast<float>(segments);
+      m.positions.emplace_back(r * std::cos(a), r * std::sin(a), h * static_cast<float>(j) / static_cast<float>(stacks));
+    }
+  const auto id = [segments](int i, int j) { return static_cast<std::uint32_t>(j * segments + (i % segments)); };
+  for (int j = 0; j < stacks; ++j)
+    for (int i = 0; i < segments; ++i) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return m;
+}
+
+struct CylinderGrid {
+  float r = 1.0f, h = 4.0f;
+  int segments = 64, stacks = 40;
+  std::uint32_t texels_per_column = 4;  // atlas texels per column around
+  float texels_per_unit() const {
+    return static_cast<float>(texels_per_column * static_cast<std::uint32_t>(segments)) / (2.0f * std::numbers::pi_v<float> * r);
+  }
+};
+
+// The cylinder as one wrapping chart at (x0, y0): x = angle, y = height, isometric.
+inline diffusion::AtlasMapping cylinder_wrapping_mapping(const Mesh& m, const CylinderGrid& g, std::uint32_t size,
+                                                         std::uint32_t x0 = 2, std::uint32_t y0 = 2) {
+  diffusion::AtlasMapping a;
+  a.size = size;
+  const float tpu = g.texels_per_unit();
+  diffusion::Chart c;
+  c.kind = diffusion::Chart::Kind::Bone;
+  c.x0 = x0;
+  c.y0 = y0;
+  c.width = g.texels_per_column * static_cast<std::uint32_t>(g.segments);
+  c.height = static_cast<std::uint32_t>(std::ceil(g.h * tpu)) + 1;
+  c.wraps_x = true;
+  c.texels_per_unit = tpu;
+  a.charts.push_back(c);
+  const auto uv = [&](std::uint32_t v) {
+    const int i = static_cast<int>(v) % g.segments, j = static_cast<int>(v) / g.segments;
+    return glm::vec2(static_cast<float>(x0) + static_cast<float>(i * static_cast<int>(g.texels_per_column)),
+                     static_cast<float>(y0) + 0.5f + tpu * g.h * static_cast<float>(j) / static_cast<float>(g.stacks));
+  };
+  for (std::uint32_t f = 0; f < m.face_count(); ++f) {
+    diffusion::AtlasTriangle t;
+    t.chart = 0;
+    t.face = f;
+    for (int k = 0; k < 3; ++k) t.uv[k] = uv(m.triangles[f][static_cast<std::size_t>(k)]);
+    a.triangles.push_back(t);
+  }
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+    a.vertex_chart.push_back(0);
+    a.vertex_uv.push_back(uv(v));
+  }
+  return a;
+}
+
+// The cylinder cut into `parts` non-wrapping charts around, each carrying its own columns and
+// `overlap` columns of its neighbours' triangles on each side (duplicated), side by side in x.
+inline diffusion::AtlasMapping cylinder_split_mapping(const Mesh& m, const CylinderGrid& g, std::uint32_t size,
+                                                      int parts, int overlap) {
+  diffusion::AtlasMapping a;
+  a.size = size;
+  a.gutter = 2;
+  const float tpu = g.texels_per_unit();
+  const int per = g.segments / parts;
+  const int cols = per + 2 * overlap;
+  const auto tc = static_cast<int>(g.texels_per_column);
+  std::uint32_t x = a.gutter;
+  for (int p = 0; p < parts; ++p) {
+    diffusion::Chart c;
+    c.x0 = x;
+    c.y0 = a.gutter;
+    c.width = static_cast<std::uint32_t>(cols * tc + 1);
+    c.height = static_cast<std::uint32_t>(std::ceil(g.h * tpu)) + 1;
+    c.texels_per_unit = tpu;
+    a.charts.push_back(c);
+    x += c.width + a.gutter;
+  }
+  // Column i (0..segments-1) as seen from chart p: offset from the chart's first column.
+  const auto local_col = [&](int p, int i) {
+    int d = i - (p * per - overlap);
+    d = ((d % g.segments) + g.segments) % g.segments;
+    return d;  // 0..segments-1; inside the chart when <= cols
+  };
+  const auto uv_in = [&](int p, int i, int j) {
+    const auto& c = a.charts[static_cast<std::size_t>(p)];
+    return glm::vec2(static_cast<float>(c.x0) + 0.5f + static_cast<float>(local_col(p, i) * tc),
+                     static_cast<float>(c.y0) + 0.5f + tpu * g.h * static_cast<float>(j) / static_cast<float>(g.stacks));
+  };
+  for (std::uint32_t f = 0; f < m.face_count(); ++f) {
+    // The quad column of the face: its smallest i, across the seam the last one.
+    int is[3], js[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<int>(m.triangles[f][static_cast<std::size_t>(k)]);
+      is[k] = v % g.segments;
+      js[k] = v / g.segments;
+    }
+    const int lo = *std::min_element(is, is + 3), hi = *std::max_element(is, is + 3);
+    const int col = (hi - lo > 1) ? hi : lo;
+    for (int p = 0; p < parts; ++p) {
+      const int d = local_col(p, col);
+      if (d + 1 > cols) continue;  // the quad's right column must lie in the chart too
+      diffusion::AtlasTriangle t;
+      t.chart = static_cast<std::uint32_t>(p);
+      t.face = f;
+      for (int k = 0; k < 3; ++k) t.uv[k] = uv_in(p, is[k], js[k]);
+      a.triangles.push_back(t);
+    }
+  }
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+    const int i = static_cast<int>(v) % g.segments, j = static_cast<int>(v) / g.segments;
+    const int p = i / per;
+    a.vertex_chart.push_back(static_cast<std::uint32_t>(p));
+    a.vertex_uv.push_back(uv_in(p, i, j));
+  }
+  return a;
+}
+
+// Per mesh edge |u_a - u_b| / |x_a - x_b|, split into edges whose ends read back from different
+// charts (seams) and the others.
+struct SeamJumps {
+  std::vector<double> border, inside;
+};
+inline SeamJumps seam_jumps(const Mesh& m, const diffusion::AtlasMapping& a, std::span<const float> u) {
+  SeamJumps s;
+  std::set<std::pair<std::uint32_t, std::uint32_t>> seen;
+  for (const auto& tri : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t p = tri[static_cast<std::size_t>(k)], q = tri[static_cast<std::size_t>((k + 1) % 3)];
+      if (p > q) std::swap(p, q);
+      if (!seen.insert({p, q}).second) continue;
+      const double jump = std::abs(static_cast<double>(u[p]) - u[q]) / glm::length(m.positions[p] - m.positions[q]);
+      (a.vertex_chart[p] != a.vertex_chart[q] ? s.border : s.inside).push_back(jump);
+    }
+  return s;
+}
+
+inline double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+inline double rms_difference(std::span<const float> a, std::span<const float> b) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += (static_cast<double>(a[i]) - b[i]) * (static_cast<double>(a[i]) - b[i]);
+  return std::sqrt(s / static_cast<double>(std::max<std::size_t>(a.size(), 1)));
+}
+
+}  // namespace sdfkit::test
