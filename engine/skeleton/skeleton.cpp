@@ -27,6 +27,7 @@
 #include <map>
 #include <optional>
 #include <numeric>
+#include <queue>
 #include <set>
 
 namespace sdfkit::skeleton {
@@ -574,6 +575,37 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   sk.curve_reliability = 1.0 - static_cast<double>(failing) / static_cast<double>(n);
   watch.lap("visibility");
 
+  // A curve node whose vertices all moved to nodes they see is merged below into its nearest
+  // graph neighbour; where that neighbour and the node share another neighbour, the merge would
+  // close a triangle of the graph to a double edge and so remove a cycle (a handle of a coarse
+  // mesh whose three nodes are its whole ring: 3torus, P). Such a node keeps one vertex: of the
+  // vertices the surgery gave it, the one nearest to it that sees it (else the nearest), taken
+  // from a node that keeps at least one.
+  for (std::uint32_t c = 0; c < curve_nodes; ++c) {
+    if (!members[c].empty() || graph_adjacency[c].size() < 2) continue;
+    std::uint32_t nearest = graph_adjacency[c].front();
+    for (std::uint32_t d : graph_adjacency[c])
+      if (glm::length(position[d] - position[c]) < glm::length(position[nearest] - position[c])) nearest = d;
+    bool closes = false;
+    for (std::uint32_t d : graph_adjacency[c])
+      if (d != nearest && std::find(graph_adjacency[nearest].begin(), graph_adjacency[nearest].end(), d) !=
+                              graph_adjacency[nearest].end())
+        closes = true;
+    if (!closes) continue;
+    std::uint32_t best = UINT32_MAX;
+    float best_d = std::numeric_limits<float>::max();
+    bool best_sees = false;
+    for (std::uint32_t k : graph.members[c]) {
+      if (in_sheet[k] || owner[k] == c || members[owner[k]].size() < 2) continue;
+      const bool sees = surface.sees(k, position[c]);
+      const float d = glm::length(original.positions[k] - position[c]);
+      if ((sees && !best_sees) || (sees == best_sees && d < best_d)) best = k, best_d = d, best_sees = sees;
+    }
+    if (best == UINT32_MAX) continue;
+    std::erase(members[owner[best]], best);
+    owner[best] = c;
+    members[c].push_back(best);
+  }
   // Curve nodes that still represent vertices, in order, then one sheet node per sheet vertex.
   std::vector<std::uint32_t> node_of_curve(curve_nodes, UINT32_MAX);
   for (std::uint32_t c = 0; c < curve_nodes; ++c) {
@@ -681,6 +713,25 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
       return !surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position);
     };
     if (!blocked.empty()) {
+      // Genus of the mesh component of each vertex (Euler characteristic per component).
+      std::vector<int> vertex_genus(n, 0);
+      {
+        UnionFind comp(n);
+        for (const Triangle& t : original.triangles) comp.unite(t[0], t[1]), comp.unite(t[1], t[2]);
+        std::map<std::uint32_t, long long> chi;
+        std::set<std::array<std::uint32_t, 2>> mesh_edges;
+        for (const Triangle& t : original.triangles) {
+          chi[comp.find(t[0])] += 1;
+          for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+        }
+        for (std::uint32_t k = 0; k < n; ++k) chi[comp.find(k)] += 1;
+        for (const auto& me : mesh_edges) chi[comp.find(me[0])] -= 1;
+        for (std::uint32_t k = 0; k < n; ++k)
+          vertex_genus[k] = static_cast<int>(std::max(0LL, (2 - chi[comp.find(k)]) / 2));
+      }
+      auto in_handle_body = [&](std::uint32_t node) {
+        return !sk.nodes[node].vertices.empty() && vertex_genus[sk.nodes[node].vertices.front()] > 0;
+      };
       for (const auto& e : blocked) edges.erase(e);
       std::vector<std::array<std::uint32_t, 2>> unresolved;
       for (const auto& e : blocked) {
@@ -692,8 +743,14 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         const std::size_t tried = std::min<std::size_t>(via.size(), 256);
         std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
         bool detoured = false;
+        // In a component of genus > 0, a detour along two edges the skeleton already has would
+        // drop the edge's cycle (a coarse handle's ring of three nodes: P, 3torus); those wait
+        // for a detour through a new node below.
+        const bool keep_cycle = in_handle_body(e[0]);
         for (std::size_t i = 0; i < tried && !detoured; ++i)
-          if (inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
+          if (!(keep_cycle && edges.count({std::min(e[0], via[i].second), std::max(e[0], via[i].second)}) &&
+                edges.count({std::min(e[1], via[i].second), std::max(e[1], via[i].second)})) &&
+              inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
             add_edge(e[0], via[i].second);
             add_edge(via[i].second, e[1]);
             detoured = true;
@@ -735,10 +792,62 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         }
         if (!detoured) still.push_back(e);
       }
+      // Then the shortest path from one end to the other through nodes whose surface regions
+      // touch (a mesh edge joins their vertices), every step inside the solid: the skeleton
+      // follows the surface around the concavity the edge cut across.
+      std::vector<std::array<std::uint32_t, 2>> unrouted;
+      if (!still.empty()) {
+        std::vector<std::vector<std::uint32_t>> touching(sk.nodes.size());
+        for (const Triangle& t : original.triangles)
+          for (int i = 0; i < 3; ++i) {
+            const std::uint32_t a = node_of_vertex[t[i]], b = node_of_vertex[t[(i + 1) % 3]];
+            if (a != b && a != UINT32_MAX && b != UINT32_MAX) touching[a].push_back(b);
+          }
+        for (auto& list : touching) {
+          std::sort(list.begin(), list.end());
+          list.erase(std::unique(list.begin(), list.end()), list.end());
+        }
+        std::map<std::array<std::uint32_t, 2>, bool> inside_cache;
+        auto step_inside = [&](std::uint32_t a, std::uint32_t b) {
+          const std::array<std::uint32_t, 2> key{std::min(a, b), std::max(a, b)};
+          const auto it = inside_cache.find(key);
+          if (it != inside_cache.end()) return it->second;
+          return inside_cache[key] = inside_segment(a, b);
+        };
+        for (const auto& e : still) {
+          std::vector<float> dist(sk.nodes.size(), std::numeric_limits<float>::infinity());
+          std::vector<std::uint32_t> from(sk.nodes.size(), UINT32_MAX);
+          using Item = std::pair<float, std::uint32_t>;
+          std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+          dist[e[0]] = 0.0f;
+          queue.push({0.0f, e[0]});
+          while (!queue.empty()) {
+            const auto [d, x] = queue.top();
+            queue.pop();
+            if (d > dist[x]) continue;
+            if (x == e[1]) break;
+            for (std::uint32_t y : touching[x]) {
+              if ((x == e[0] && y == e[1]) || (x == e[1] && y == e[0])) continue;
+              const float nd = d + glm::length(sk.nodes[x].position - sk.nodes[y].position);
+              if (nd < dist[y] && step_inside(x, y)) {
+                dist[y] = nd, from[y] = x;
+                queue.push({nd, y});
+              }
+            }
+          }
+          if (from[e[1]] == UINT32_MAX) {
+            unrouted.push_back(e);
+            continue;
+          }
+          for (std::uint32_t y = e[1]; y != e[0]; y = from[y]) add_edge(from[y], y);
+        }
+        log_debug("skeleton: " + std::to_string(still.size() - unrouted.size()) + " of " +
+                  std::to_string(still.size()) + " edges re-routed along touching regions");
+      }
       UnionFind parts(sk.nodes.size());
       for (const auto& e : edges) parts.unite(e[0], e[1]);
       for (const Triangle& t : sk.sheet_triangles) parts.unite(t[0], t[1]), parts.unite(t[1], t[2]);
-      for (const auto& e : still) {
+      for (const auto& e : unrouted) {
         const std::uint32_t ra = parts.find(e[0]), rb = parts.find(e[1]);
         if (ra == rb) {
           add_edge(e[0], e[1]);
