@@ -1049,7 +1049,22 @@ Skeleton extract_manifold(const Mesh& mesh, SdfBackend* backend, const Contracti
     }
   }
   t = Clock::now();
-  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, contraction, proxy_first_sdf);
+  // A mesh with a handle (a component of genus > 0: V - E + F < 2 per component) is contracted
+  // with ContractionOptions::sl_handles.
+  ContractionOptions used = contraction;
+  {
+    std::vector<std::uint64_t> mesh_edges;
+    mesh_edges.reserve(3 * mesh.triangles.size());
+    for (const Triangle& tri : mesh.triangles)
+      for (int i = 0; i < 3; ++i)
+        mesh_edges.push_back(std::uint64_t{std::min(tri[i], tri[(i + 1) % 3])} << 32 | std::max(tri[i], tri[(i + 1) % 3]));
+    std::sort(mesh_edges.begin(), mesh_edges.end());
+    mesh_edges.erase(std::unique(mesh_edges.begin(), mesh_edges.end()), mesh_edges.end());
+    const auto chi = static_cast<long long>(mesh.positions.size()) - static_cast<long long>(mesh_edges.size()) +
+                     static_cast<long long>(mesh.triangles.size());
+    if (chi < 2 * static_cast<long long>(analyze(mesh).components)) used.sl = contraction.sl_handles;
+  }
+  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, used, proxy_first_sdf);
   seconds.contraction = seconds_since(t);
   seconds.contraction_sdf = c.sdf_seconds;
   seconds.contraction_solve = c.solve_seconds;
