@@ -250,6 +250,7 @@ Eval run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend, bool sdf_
   sk::ContractionOptions co;
   co.sdf_term = sdf_terms;
   if (const char* v = std::getenv("SDFKIT_EVAL_SL")) co.sl = std::atof(v);
+  if (const char* v = std::getenv("SDFKIT_EVAL_SL_HANDLES")) co.sl_handles = std::atof(v);
   if (const char* v = std::getenv("SDFKIT_EVAL_PROXY")) co.proxy_vertices = static_cast<std::size_t>(std::atol(v));
   try {
     const auto t0 = std::chrono::steady_clock::now();
