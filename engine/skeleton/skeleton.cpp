@@ -844,10 +844,104 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         log_debug("skeleton: " + std::to_string(still.size() - unrouted.size()) + " of " +
                   std::to_string(still.size()) + " edges re-routed along touching regions");
       }
+      // Last, a chain of new nodes along the centre points of a path of surface vertices from
+      // one end's vertices to the other's (Dijkstra over mesh edges, near the edge: centre points
+      // within |ab| of its midpoint; every step between centre points inside), thinned to the
+      // farthest visible centre point at each step; each new node takes its vertex from a node
+      // that keeps at least one.
+      std::vector<std::array<std::uint32_t, 2>> left;
+      if (!unrouted.empty()) {
+        std::vector<std::vector<std::uint32_t>> vertex_nbrs(n);
+        for (const Triangle& t : original.triangles)
+          for (int i = 0; i < 3; ++i) vertex_nbrs[t[i]].push_back(t[(i + 1) % 3]), vertex_nbrs[t[(i + 1) % 3]].push_back(t[i]);
+        for (const auto& e : unrouted) {
+          const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+          const glm::vec3 mid = 0.5f * (pa + pb);
+          const float reach = glm::length(pb - pa);
+          auto near = [&](std::uint32_t k) { return glm::length(surface.centre[k] - mid) <= reach; };
+          std::map<std::uint32_t, float> dist;
+          std::map<std::uint32_t, std::uint32_t> from;
+          using Item = std::pair<float, std::uint32_t>;
+          std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+          for (std::uint32_t k : sk.nodes[e[0]].vertices)
+            if (near(k) && !surface.bvh.segment_blocked(pa, surface.centre[k])) {
+              const float d = glm::length(surface.centre[k] - pa);
+              dist[k] = d, from[k] = UINT32_MAX;
+              queue.push({d, k});
+            }
+          std::uint32_t reached = UINT32_MAX;
+          std::size_t settled = 0;
+          while (!queue.empty() && settled < 20000) {
+            const auto [d, k] = queue.top();
+            queue.pop();
+            if (d > dist[k]) continue;
+            ++settled;
+            if (node_of_vertex[k] == e[1] && !surface.bvh.segment_blocked(surface.centre[k], pb)) {
+              reached = k;
+              break;
+            }
+            for (std::uint32_t l : vertex_nbrs[k]) {
+              if (!near(l)) continue;
+              const float nd = d + glm::length(surface.centre[l] - surface.centre[k]);
+              const auto it = dist.find(l);
+              if ((it == dist.end() || nd < it->second) &&
+                  !surface.bvh.segment_blocked(surface.centre[k], surface.centre[l])) {
+                dist[l] = nd, from[l] = k;
+                queue.push({nd, l});
+              }
+            }
+          }
+          if (reached == UINT32_MAX) {
+            left.push_back(e);
+            continue;
+          }
+          std::vector<std::uint32_t> path;
+          for (std::uint32_t k = reached; k != UINT32_MAX; k = from[k]) path.push_back(k);
+          std::reverse(path.begin(), path.end());
+          // Waypoints: from the current point, the farthest path vertex whose centre it sees.
+          std::vector<std::uint32_t> waypoints;
+          glm::vec3 current = pa;
+          std::size_t i = 0;
+          while (surface.bvh.segment_blocked(current, pb) && i < path.size()) {
+            std::size_t j = path.size() - 1;
+            while (j > i && surface.bvh.segment_blocked(current, surface.centre[path[j]])) --j;
+            waypoints.push_back(path[j]);
+            current = surface.centre[path[j]];
+            i = j + 1;
+          }
+          bool ok = !surface.bvh.segment_blocked(current, pb);
+          std::map<std::uint32_t, std::size_t> taken;  // node -> vertices taken from it
+          for (std::uint32_t k : waypoints) {
+            const std::uint32_t node = node_of_vertex[k];
+            if (node == UINT32_MAX || sk.nodes[node].vertices.size() < 2 + taken[node]) ok = false;
+            ++taken[node];
+          }
+          if (!ok) {
+            left.push_back(e);
+            continue;
+          }
+          std::uint32_t previous = e[0];
+          for (std::uint32_t k : waypoints) {
+            std::erase(sk.nodes[node_of_vertex[k]].vertices, k);
+            Node node;
+            node.position = surface.centre[k];
+            node.vertices = {k};
+            node.radius = surface.radius(node.position, node.vertices);
+            const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+            sk.nodes.push_back(std::move(node));
+            node_of_vertex[k] = id;
+            add_edge(previous, id);
+            previous = id;
+          }
+          add_edge(previous, e[1]);
+        }
+        log_debug("skeleton: " + std::to_string(unrouted.size() - left.size()) + " of " +
+                  std::to_string(unrouted.size()) + " edges re-routed along centre points");
+      }
       UnionFind parts(sk.nodes.size());
       for (const auto& e : edges) parts.unite(e[0], e[1]);
       for (const Triangle& t : sk.sheet_triangles) parts.unite(t[0], t[1]), parts.unite(t[1], t[2]);
-      for (const auto& e : unrouted) {
+      for (const auto& e : left) {
         const std::uint32_t ra = parts.find(e[0]), rb = parts.find(e[1]);
         if (ra == rb) {
           add_edge(e[0], e[1]);
