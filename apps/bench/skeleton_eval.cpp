@@ -249,6 +249,9 @@ Eval run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend, bool sdf_
                 const sdfkit::skeleton::detail::TriangleBvh& bvh, const std::string& dump_path) {
   sk::ContractionOptions co;
   co.sdf_term = sdf_terms;
+  if (const char* v = std::getenv("SDFKIT_EVAL_SL")) co.sl = std::atof(v);
+  if (const char* v = std::getenv("SDFKIT_EVAL_SL_HANDLES")) co.sl_handles = std::atof(v);
+  if (const char* v = std::getenv("SDFKIT_EVAL_PROXY")) co.proxy_vertices = static_cast<std::size_t>(std::atol(v));
   try {
     const auto t0 = std::chrono::steady_clock::now();
     sk::SkeletonOptions so;  // library defaults; SDFKIT_EVAL_EXTEND_LEAVES=0 for the comparison

@@ -32,6 +32,7 @@ void validate(const ContractionOptions& o) {
   auto bad = [](const std::string& what) { throw InputError("contraction option " + what); };
   if (!(o.wl_scale > 0.0) || !std::isfinite(o.wl_scale)) bad("wl_scale must be positive");
   if (!(o.sl >= 1.0) || !std::isfinite(o.sl)) bad("sl (contraction growth) must be at least 1");
+  if (!(o.sl_handles >= 1.0) || !std::isfinite(o.sl_handles)) bad("sl_handles (contraction growth) must be at least 1");
   if (!(o.wh0 > 0.0) || !std::isfinite(o.wh0)) bad("wh0 (holding weight) must be positive");
   if (!(o.wc >= 0.0) || !std::isfinite(o.wc)) bad("wc (SDF centering weight) must be >= 0");
   if (!(o.sdf_bias > 0.0 && o.sdf_bias <= 1.0)) bad("sdf_bias must be in (0, 1]");

@@ -27,6 +27,7 @@
 #include <map>
 #include <optional>
 #include <numeric>
+#include <queue>
 #include <set>
 
 namespace sdfkit::skeleton {
@@ -574,6 +575,37 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   sk.curve_reliability = 1.0 - static_cast<double>(failing) / static_cast<double>(n);
   watch.lap("visibility");
 
+  // A curve node whose vertices all moved to nodes they see is merged below into its nearest
+  // graph neighbour; where that neighbour and the node share another neighbour, the merge would
+  // close a triangle of the graph to a double edge and so remove a cycle (a handle of a coarse
+  // mesh whose three nodes are its whole ring: 3torus, P). Such a node keeps one vertex: of the
+  // vertices the surgery gave it, the one nearest to it that sees it (else the nearest), taken
+  // from a node that keeps at least one.
+  for (std::uint32_t c = 0; c < curve_nodes; ++c) {
+    if (!members[c].empty() || graph_adjacency[c].size() < 2) continue;
+    std::uint32_t nearest = graph_adjacency[c].front();
+    for (std::uint32_t d : graph_adjacency[c])
+      if (glm::length(position[d] - position[c]) < glm::length(position[nearest] - position[c])) nearest = d;
+    bool closes = false;
+    for (std::uint32_t d : graph_adjacency[c])
+      if (d != nearest && std::find(graph_adjacency[nearest].begin(), graph_adjacency[nearest].end(), d) !=
+                              graph_adjacency[nearest].end())
+        closes = true;
+    if (!closes) continue;
+    std::uint32_t best = UINT32_MAX;
+    float best_d = std::numeric_limits<float>::max();
+    bool best_sees = false;
+    for (std::uint32_t k : graph.members[c]) {
+      if (in_sheet[k] || owner[k] == c || members[owner[k]].size() < 2) continue;
+      const bool sees = surface.sees(k, position[c]);
+      const float d = glm::length(original.positions[k] - position[c]);
+      if ((sees && !best_sees) || (sees == best_sees && d < best_d)) best = k, best_d = d, best_sees = sees;
+    }
+    if (best == UINT32_MAX) continue;
+    std::erase(members[owner[best]], best);
+    owner[best] = c;
+    members[c].push_back(best);
+  }
   // Curve nodes that still represent vertices, in order, then one sheet node per sheet vertex.
   std::vector<std::uint32_t> node_of_curve(curve_nodes, UINT32_MAX);
   for (std::uint32_t c = 0; c < curve_nodes; ++c) {
@@ -681,6 +713,25 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
       return !surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position);
     };
     if (!blocked.empty()) {
+      // Genus of the mesh component of each vertex (Euler characteristic per component).
+      std::vector<int> vertex_genus(n, 0);
+      {
+        UnionFind comp(n);
+        for (const Triangle& t : original.triangles) comp.unite(t[0], t[1]), comp.unite(t[1], t[2]);
+        std::map<std::uint32_t, long long> chi;
+        std::set<std::array<std::uint32_t, 2>> mesh_edges;
+        for (const Triangle& t : original.triangles) {
+          chi[comp.find(t[0])] += 1;
+          for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+        }
+        for (std::uint32_t k = 0; k < n; ++k) chi[comp.find(k)] += 1;
+        for (const auto& me : mesh_edges) chi[comp.find(me[0])] -= 1;
+        for (std::uint32_t k = 0; k < n; ++k)
+          vertex_genus[k] = static_cast<int>(std::max(0LL, (2 - chi[comp.find(k)]) / 2));
+      }
+      auto in_handle_body = [&](std::uint32_t node) {
+        return !sk.nodes[node].vertices.empty() && vertex_genus[sk.nodes[node].vertices.front()] > 0;
+      };
       for (const auto& e : blocked) edges.erase(e);
       std::vector<std::array<std::uint32_t, 2>> unresolved;
       for (const auto& e : blocked) {
@@ -692,8 +743,14 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         const std::size_t tried = std::min<std::size_t>(via.size(), 256);
         std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
         bool detoured = false;
+        // In a component of genus > 0, a detour along two edges the skeleton already has would
+        // drop the edge's cycle (a coarse handle's ring of three nodes: P, 3torus); those wait
+        // for a detour through a new node below.
+        const bool keep_cycle = in_handle_body(e[0]);
         for (std::size_t i = 0; i < tried && !detoured; ++i)
-          if (inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
+          if (!(keep_cycle && edges.count({std::min(e[0], via[i].second), std::max(e[0], via[i].second)}) &&
+                edges.count({std::min(e[1], via[i].second), std::max(e[1], via[i].second)})) &&
+              inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
             add_edge(e[0], via[i].second);
             add_edge(via[i].second, e[1]);
             detoured = true;
@@ -735,10 +792,156 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         }
         if (!detoured) still.push_back(e);
       }
+      // Then the shortest path from one end to the other through nodes whose surface regions
+      // touch (a mesh edge joins their vertices), every step inside the solid: the skeleton
+      // follows the surface around the concavity the edge cut across.
+      std::vector<std::array<std::uint32_t, 2>> unrouted;
+      if (!still.empty()) {
+        std::vector<std::vector<std::uint32_t>> touching(sk.nodes.size());
+        for (const Triangle& t : original.triangles)
+          for (int i = 0; i < 3; ++i) {
+            const std::uint32_t a = node_of_vertex[t[i]], b = node_of_vertex[t[(i + 1) % 3]];
+            if (a != b && a != UINT32_MAX && b != UINT32_MAX) touching[a].push_back(b);
+          }
+        for (auto& list : touching) {
+          std::sort(list.begin(), list.end());
+          list.erase(std::unique(list.begin(), list.end()), list.end());
+        }
+        std::map<std::array<std::uint32_t, 2>, bool> inside_cache;
+        auto step_inside = [&](std::uint32_t a, std::uint32_t b) {
+          const std::array<std::uint32_t, 2> key{std::min(a, b), std::max(a, b)};
+          const auto it = inside_cache.find(key);
+          if (it != inside_cache.end()) return it->second;
+          return inside_cache[key] = inside_segment(a, b);
+        };
+        for (const auto& e : still) {
+          std::vector<float> dist(sk.nodes.size(), std::numeric_limits<float>::infinity());
+          std::vector<std::uint32_t> from(sk.nodes.size(), UINT32_MAX);
+          using Item = std::pair<float, std::uint32_t>;
+          std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+          dist[e[0]] = 0.0f;
+          queue.push({0.0f, e[0]});
+          while (!queue.empty()) {
+            const auto [d, x] = queue.top();
+            queue.pop();
+            if (d > dist[x]) continue;
+            if (x == e[1]) break;
+            for (std::uint32_t y : touching[x]) {
+              if ((x == e[0] && y == e[1]) || (x == e[1] && y == e[0])) continue;
+              const float nd = d + glm::length(sk.nodes[x].position - sk.nodes[y].position);
+              if (nd < dist[y] && step_inside(x, y)) {
+                dist[y] = nd, from[y] = x;
+                queue.push({nd, y});
+              }
+            }
+          }
+          if (from[e[1]] == UINT32_MAX) {
+            unrouted.push_back(e);
+            continue;
+          }
+          for (std::uint32_t y = e[1]; y != e[0]; y = from[y]) add_edge(from[y], y);
+        }
+        log_debug("skeleton: " + std::to_string(still.size() - unrouted.size()) + " of " +
+                  std::to_string(still.size()) + " edges re-routed along touching regions");
+      }
+      // Last, a chain of new nodes along the centre points of a path of surface vertices from
+      // one end's vertices to the other's (Dijkstra over mesh edges, near the edge: centre points
+      // within |ab| of its midpoint; every step between centre points inside), thinned to the
+      // farthest visible centre point at each step; each new node takes its vertex from a node
+      // that keeps at least one.
+      std::vector<std::array<std::uint32_t, 2>> left;
+      if (!unrouted.empty()) {
+        std::vector<std::vector<std::uint32_t>> vertex_nbrs(n);
+        for (const Triangle& t : original.triangles)
+          for (int i = 0; i < 3; ++i) vertex_nbrs[t[i]].push_back(t[(i + 1) % 3]), vertex_nbrs[t[(i + 1) % 3]].push_back(t[i]);
+        for (const auto& e : unrouted) {
+          const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+          const glm::vec3 mid = 0.5f * (pa + pb);
+          const float reach = glm::length(pb - pa);
+          auto near = [&](std::uint32_t k) { return glm::length(surface.centre[k] - mid) <= reach; };
+          std::map<std::uint32_t, float> dist;
+          std::map<std::uint32_t, std::uint32_t> from;
+          using Item = std::pair<float, std::uint32_t>;
+          std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+          for (std::uint32_t k : sk.nodes[e[0]].vertices)
+            if (near(k) && !surface.bvh.segment_blocked(pa, surface.centre[k])) {
+              const float d = glm::length(surface.centre[k] - pa);
+              dist[k] = d, from[k] = UINT32_MAX;
+              queue.push({d, k});
+            }
+          std::uint32_t reached = UINT32_MAX;
+          std::size_t settled = 0;
+          while (!queue.empty() && settled < 20000) {
+            const auto [d, k] = queue.top();
+            queue.pop();
+            if (d > dist[k]) continue;
+            ++settled;
+            if (node_of_vertex[k] == e[1] && !surface.bvh.segment_blocked(surface.centre[k], pb)) {
+              reached = k;
+              break;
+            }
+            for (std::uint32_t l : vertex_nbrs[k]) {
+              if (!near(l)) continue;
+              const float nd = d + glm::length(surface.centre[l] - surface.centre[k]);
+              const auto it = dist.find(l);
+              if ((it == dist.end() || nd < it->second) &&
+                  !surface.bvh.segment_blocked(surface.centre[k], surface.centre[l])) {
+                dist[l] = nd, from[l] = k;
+                queue.push({nd, l});
+              }
+            }
+          }
+          if (reached == UINT32_MAX) {
+            left.push_back(e);
+            continue;
+          }
+          std::vector<std::uint32_t> path;
+          for (std::uint32_t k = reached; k != UINT32_MAX; k = from[k]) path.push_back(k);
+          std::reverse(path.begin(), path.end());
+          // Waypoints: from the current point, the farthest path vertex whose centre it sees.
+          std::vector<std::uint32_t> waypoints;
+          glm::vec3 current = pa;
+          std::size_t i = 0;
+          while (surface.bvh.segment_blocked(current, pb) && i < path.size()) {
+            std::size_t j = path.size() - 1;
+            while (j > i && surface.bvh.segment_blocked(current, surface.centre[path[j]])) --j;
+            waypoints.push_back(path[j]);
+            current = surface.centre[path[j]];
+            i = j + 1;
+          }
+          bool ok = !surface.bvh.segment_blocked(current, pb);
+          std::map<std::uint32_t, std::size_t> taken;  // node -> vertices taken from it
+          for (std::uint32_t k : waypoints) {
+            const std::uint32_t node = node_of_vertex[k];
+            if (node == UINT32_MAX || sk.nodes[node].vertices.size() < 2 + taken[node]) ok = false;
+            ++taken[node];
+          }
+          if (!ok) {
+            left.push_back(e);
+            continue;
+          }
+          std::uint32_t previous = e[0];
+          for (std::uint32_t k : waypoints) {
+            std::erase(sk.nodes[node_of_vertex[k]].vertices, k);
+            Node node;
+            node.position = surface.centre[k];
+            node.vertices = {k};
+            node.radius = surface.radius(node.position, node.vertices);
+            const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+            sk.nodes.push_back(std::move(node));
+            node_of_vertex[k] = id;
+            add_edge(previous, id);
+            previous = id;
+          }
+          add_edge(previous, e[1]);
+        }
+        log_debug("skeleton: " + std::to_string(unrouted.size() - left.size()) + " of " +
+                  std::to_string(unrouted.size()) + " edges re-routed along centre points");
+      }
       UnionFind parts(sk.nodes.size());
       for (const auto& e : edges) parts.unite(e[0], e[1]);
       for (const Triangle& t : sk.sheet_triangles) parts.unite(t[0], t[1]), parts.unite(t[1], t[2]);
-      for (const auto& e : still) {
+      for (const auto& e : left) {
         const std::uint32_t ra = parts.find(e[0]), rb = parts.find(e[1]);
         if (ra == rb) {
           add_edge(e[0], e[1]);
@@ -940,7 +1143,22 @@ Skeleton extract_manifold(const Mesh& mesh, SdfBackend* backend, const Contracti
     }
   }
   t = Clock::now();
-  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, contraction, proxy_first_sdf);
+  // A mesh with a handle (a component of genus > 0: V - E + F < 2 per component) is contracted
+  // with ContractionOptions::sl_handles.
+  ContractionOptions used = contraction;
+  {
+    std::vector<std::uint64_t> mesh_edges;
+    mesh_edges.reserve(3 * mesh.triangles.size());
+    for (const Triangle& tri : mesh.triangles)
+      for (int i = 0; i < 3; ++i)
+        mesh_edges.push_back(std::uint64_t{std::min(tri[i], tri[(i + 1) % 3])} << 32 | std::max(tri[i], tri[(i + 1) % 3]));
+    std::sort(mesh_edges.begin(), mesh_edges.end());
+    mesh_edges.erase(std::unique(mesh_edges.begin(), mesh_edges.end()), mesh_edges.end());
+    const auto chi = static_cast<long long>(mesh.positions.size()) - static_cast<long long>(mesh_edges.size()) +
+                     static_cast<long long>(mesh.triangles.size());
+    if (chi < 2 * static_cast<long long>(analyze(mesh).components)) used.sl = contraction.sl_handles;
+  }
+  ContractionResult c = contract(use_proxy ? proxy.mesh : mesh, backend, used, proxy_first_sdf);
   seconds.contraction = seconds_since(t);
   seconds.contraction_sdf = c.sdf_seconds;
   seconds.contraction_solve = c.solve_seconds;

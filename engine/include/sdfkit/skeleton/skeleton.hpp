@@ -65,6 +65,13 @@ struct ContractionOptions {
   // vertex distance to the medial axis 0.042 against 0.049; 0.061 and 0.080 without the SDF
   // term); CGAL's cow: curve reliability 0.91 against 0.82. Hence 3.
   double sl = 3.0;
+  // S_L instead of `sl` when a component of the mesh has genus > 0. A faster contraction
+  // shrinks a ring faster than the holding weights hold it, and the handle closes before the
+  // surgery sees it. Measured over CGAL's data set (eval, genus > 0 meshes): with 3, cycles =
+  // genus failed on anchor 3/4, couplingdown 3/9, pipe 0/1, mpi 2/1, elephant 6/3 (75 % sheet
+  // nodes); with 2 all of these hold (elephant 0 % sheets), joint went 2 -> 1 of 2, at ~1.5x the
+  // iterations. Genus-0 meshes keep `sl` (their speed is where 3 was chosen).
+  double sl_handles = 2.0;
   // ... or by sl^2 after an iteration that shrank the total area by less than this fraction
   // (0 = never): a stall while thin parts, held by the SDF weights, wait for W_L.
   double stall_ratio = 0.0;
