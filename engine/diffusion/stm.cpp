@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -567,6 +568,31 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     }
   };
 
+  // Turns every planar chart's (b1, b2) to the principal axes of its vertices' projections, so
+  // its rectangle (the bounding box) wastes less of the atlas on elongated, diagonal pieces.
+  const auto align_planar_charts = [&] {
+    std::vector<std::array<double, 6>> acc(maps.size(), {0, 0, 0, 0, 0, 0});  // n, x, y, xx, yy, xy
+    for (std::size_t v = 0; v < V; ++v) {
+      const ChartMap& m = maps[vchart[v]];
+      if (m.kind == Chart::Kind::Bone || m.cap) continue;
+      const glm::dvec3 p(mesh.positions[v]);
+      const double x = glm::dot(p, m.b1), y = glm::dot(p, m.b2);
+      auto& a = acc[vchart[v]];
+      a[0] += 1, a[1] += x, a[2] += y, a[3] += x * x, a[4] += y * y, a[5] += x * y;
+    }
+    for (std::size_t c = 0; c < maps.size(); ++c) {
+      const auto& a = acc[c];
+      if (a[0] < 3) continue;
+      const double mx = a[1] / a[0], my = a[2] / a[0];
+      const double cxx = a[3] / a[0] - mx * mx, cyy = a[4] / a[0] - my * my, cxy = a[5] / a[0] - mx * my;
+      const double angle = 0.5 * std::atan2(2 * cxy, cxx - cyy);
+      ChartMap& m = maps[c];
+      const glm::dvec3 b1 = std::cos(angle) * m.b1 + std::sin(angle) * m.b2;
+      m.b1 = glm::normalize(b1);
+      m.b2 = glm::cross(m.axis, m.b1);
+    }
+  };
+
   // Local corners of face f in chart c (model units), wrapping charts unwrapped toward the
   // first corner that belongs to c (or corner 0).
   const auto face_local = [&](std::size_t f, std::uint32_t c, glm::dvec2 (&uv)[3]) {
@@ -626,6 +652,8 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       if (demote[v]) region[v] = Region::Joint, owner[v] = kNone;
     if (round == 11) build_charts();
   }
+
+  align_planar_charts();
 
   // 5. Atlas triangles in local coordinates; chart extents.
   struct LocalTri {
@@ -769,6 +797,46 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     all_area.push_back({ad, area});
     all_angle.push_back({gd, area});
   }
+  // Coverage: texel centres inside each atlas triangle (wrapping charts: also shifted by ±width),
+  // counted per texel.
+  {
+    std::vector<std::uint8_t> count(static_cast<std::size_t>(am.size) * am.size, 0);
+    for (const AtlasTriangle& at : am.triangles) {
+      const Chart& ch = am.charts[at.chart];
+      for (int sh = ch.wraps_x ? -1 : 0; sh <= (ch.wraps_x ? 1 : 0); ++sh) {
+        glm::dvec2 a(at.uv[0]), b(at.uv[1]), c(at.uv[2]);
+        a.x += sh * double(ch.width), b.x += sh * double(ch.width), c.x += sh * double(ch.width);
+        const double den = signed_area2(a, b, c);
+        if (den == 0) continue;
+        const long x0 = std::max<long>(ch.x0, static_cast<long>(std::floor(std::min({a.x, b.x, c.x}))));
+        const long x1 = std::min<long>(ch.x0 + ch.width - 1, static_cast<long>(std::floor(std::max({a.x, b.x, c.x}))));
+        const long y0 = std::max<long>(ch.y0, static_cast<long>(std::floor(std::min({a.y, b.y, c.y}))));
+        const long y1 = std::min<long>(ch.y0 + ch.height - 1, static_cast<long>(std::floor(std::max({a.y, b.y, c.y}))));
+        for (long y = y0; y <= y1; ++y)
+          for (long x = x0; x <= x1; ++x) {
+            const glm::dvec2 p(x + 0.5, y + 0.5);
+            const double w0 = signed_area2(b, c, p) / den, w1 = signed_area2(c, a, p) / den, w2 = 1 - w0 - w1;
+            // Half-open on shared edges (a texel centre exactly on an edge counts once).
+            if (w0 < 0 || w1 < 0 || w2 <= 0) continue;
+            std::uint8_t& k = count[static_cast<std::size_t>(y) * am.size + static_cast<std::size_t>(x)];
+            if (k < 255) ++k;
+          }
+      }
+    }
+    std::uint64_t covered = 0, overlapped = 0;
+    for (std::size_t c = 0; c < C; ++c) {
+      const Chart& ch = am.charts[c];
+      for (std::size_t y = ch.y0; y < ch.y0 + ch.height; ++y)
+        for (std::size_t x = ch.x0; x < ch.x0 + ch.width; ++x) {
+          const std::uint8_t k = count[y * am.size + x];
+          ql.charts[c].covered += k > 0;
+          ql.charts[c].overlapped += k > 1;
+        }
+      covered += ql.charts[c].covered;
+      overlapped += ql.charts[c].overlapped;
+    }
+    ql.overlap = covered > 0 ? static_cast<double>(overlapped) / static_cast<double>(covered) : 0.0;
+  }
   double used = 0;
   for (std::size_t c = 0; c < C; ++c) {
     ChartQuality& cq = ql.charts[c];
@@ -792,11 +860,27 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
   return out;
 }
 
-std::vector<glm::vec2> normalized_vertex_uv(const AtlasMapping& mapping) {
-  std::vector<glm::vec2> uv(mapping.vertex_uv.size());
+std::vector<std::array<glm::vec2, 3>> gltf_corner_uv(const AtlasMapping& mapping, const Mesh& mesh) {
+  const std::size_t F = mesh.triangles.size();
+  if (mapping.vertex_chart.size() != mesh.positions.size())
+    throw InputError("TEXCOORD_1: the atlas mapping does not fit the mesh's vertices");
+  std::vector<std::uint32_t> want(F);
+  for (std::size_t f = 0; f < F; ++f) {
+    const Triangle& t = mesh.triangles[f];
+    const std::uint32_t a = mapping.vertex_chart[t[0]], b = mapping.vertex_chart[t[1]], c = mapping.vertex_chart[t[2]];
+    want[f] = (b == c && b != a) ? b : a;
+  }
+  std::vector<std::array<glm::vec2, 3>> out(F);
+  std::vector<std::uint8_t> found(F, 0);
   const float s = static_cast<float>(mapping.size);
-  for (std::size_t i = 0; i < uv.size(); ++i) uv[i] = mapping.vertex_uv[i] / s;
-  return uv;
+  for (const AtlasTriangle& at : mapping.triangles) {
+    if (at.face >= F || at.chart != want[at.face] || found[at.face]) continue;
+    found[at.face] = 1;
+    for (int k = 0; k < 3; ++k) out[at.face][static_cast<std::size_t>(k)] = {at.uv[k].x / s, 1.0f - at.uv[k].y / s};
+  }
+  for (std::size_t f = 0; f < F; ++f)
+    if (!found[f]) throw InputError("TEXCOORD_1: face " + std::to_string(f) + " has no atlas triangle in its chart");
+  return out;
 }
 
 }  // namespace sdfkit::diffusion
