@@ -35,9 +35,9 @@ void run(const std::string& name, const Mesh& mesh, const diffusion::StmOptions&
   for (const diffusion::ChartQuality& c : q.charts)
     if (c.kind == diffusion::Chart::Kind::Bone)
       bone_area += c.area, bone_ad += c.area * c.area_distortion.mean, bone_gd += c.area * c.angle_distortion.mean;
-  std::printf("| %s | %zu | %zu | %u / %u / %u | %.1f %% | %.1f %% | %.2f / %.2f / %.1f | %.2f / %.2f / %.1f | %.2f / %.2f | %.2f %% | %llu | %.2f | %.3f |\n",
+  std::printf("| %s | %zu | %zu | %u / %u / %u | %.1f %% | %.1f %% / %.1f %% | %.2f / %.2f / %.1f | %.2f / %.2f / %.1f | %.2f / %.2f | %.2f %% | %llu | %.2f | %.3f |\n",
               name.c_str(), mesh.positions.size(), s.nodes.size(), q.bone_charts, q.joint_charts, q.sheet_charts,
-              100.0 * q.bone_vertex_share, 100.0 * q.atlas_used, q.area_distortion.mean, q.area_distortion.p95,
+              100.0 * q.bone_vertex_share, 100.0 * q.atlas_used, 100.0 * q.atlas_covered, q.area_distortion.mean, q.area_distortion.p95,
               q.area_distortion.max, q.angle_distortion.mean, q.angle_distortion.p95, q.angle_distortion.max,
               bone_area > 0 ? bone_ad / bone_area : 0.0, bone_area > 0 ? bone_gd / bone_area : 0.0, 100.0 * q.overlap,
               static_cast<unsigned long long>(q.duplicated_triangles), skel_s, q.seconds);
@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
   std::printf("atlas %u², gutter %u. Distortion: area σ1σ2, angle σ1/σ2 (area-weighted mean / p95 / max over all charts' "
               "faces); bone: mean over bone charts.\n\n",
               options.atlas_size, options.gutter);
-  std::printf("| mesh | vertices | nodes | charts bone / joint / sheet | vertices in bone charts | atlas used | area distortion | "
+  std::printf("| mesh | vertices | nodes | charts bone / joint / sheet | vertices in bone charts | atlas in rectangles / covered | area distortion | "
               "angle distortion | bone area / angle | overlap | duplicated triangles | skeleton s | build_stm s |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   try {

@@ -26,6 +26,8 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr double kTwoPi = 6.283185307179586;
 // Angle distortion of a triangle mapped to a segment or point (σ2 = 0), and the cap of all.
 constexpr double kMaxAngleDistortion = 1000.0;
+// A connected piece of a bone's region with fewer vertices than this is charted as a planar joint.
+constexpr std::size_t kMinBonePiece = 12;
 
 // A skeleton segment between joints: the polyline through its nodes' positions, arc length at
 // each point, and a rotation-minimizing frame (n, b) per segment (double reflection, Wang et al.
@@ -152,7 +154,9 @@ enum class Region : std::uint8_t { Bone, Cap, Joint, Sheet };
 struct ChartMap {
   Chart::Kind kind = Chart::Kind::Bone;
   std::uint32_t bone = kNone;   // Bone: index into bones
-  double width = 0;             // Bone: 2π × radius (x wraps there)
+  double width = 0;             // Bone: 2π × radius (x wraps there when `wraps`)
+  double angle0 = 0;            // Bone: the angle at x = 0
+  bool wraps = true;            // Bone: the piece goes all around (else x spans the used sector)
   glm::dvec3 origin{0.0}, axis{0.0}, b1{0.0}, b2{0.0};  // Cap / planar
   double cap_radius = 0;        // Cap: ρ = polar angle × cap_radius
   bool cap = false;
@@ -164,7 +168,9 @@ glm::dvec2 local_coords(const ChartMap& c, const std::vector<Bone>& bones, const
   if (c.kind == Chart::Kind::Bone) {
     const Bone& bone = bones[c.bone];
     const BonePoint bp = closest_on_bone(bone, p);
-    return {bone_angle(bone, bp.seg, bp.radial) / kTwoPi * c.width, bp.s};
+    double a = bone_angle(bone, bp.seg, bp.radial) - c.angle0;
+    if (a < 0) a += kTwoPi;
+    return {a / kTwoPi * c.width, bp.s};
   }
   const glm::dvec3 q = p - c.origin;
   if (c.cap) {
@@ -442,19 +448,37 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
   const auto build_charts = [&] {
     maps.clear();
     bone_radii();
-    std::vector<std::uint32_t> bone_chart(B.size(), kNone), cap_chart(N, kNone);
+    std::vector<std::uint32_t> cap_chart(N, kNone);
+    std::fill(vchart.begin(), vchart.end(), kNone);
+    std::vector<std::uint32_t> pending;
     for (std::size_t v = 0; v < V; ++v) {
       if (region[v] == Region::Bone) {
-        std::uint32_t& c = bone_chart[owner[v]];
-        if (c == kNone) {
-          ChartMap m;
-          m.kind = Chart::Kind::Bone;
-          m.bone = owner[v];
-          m.width = kTwoPi * B[owner[v]].radius;
-          c = static_cast<std::uint32_t>(maps.size());
-          maps.push_back(m);
+        // One chart per connected piece of a bone's vertices (demotions can cut a bone's region
+        // in two; one rectangle over both would be mostly empty).
+        // Pieces of fewer than kMinBonePiece vertices join the planar joint regions.
+        if (vchart[v] != kNone) continue;
+        ChartMap m;
+        m.kind = Chart::Kind::Bone;
+        m.bone = owner[v];
+        m.width = kTwoPi * B[owner[v]].radius;
+        const auto id = static_cast<std::uint32_t>(maps.size());
+        maps.push_back(m);
+        vchart[v] = id;
+        std::vector<std::uint32_t> piece{static_cast<std::uint32_t>(v)};
+        pending = {static_cast<std::uint32_t>(v)};
+        while (!pending.empty()) {
+          const std::uint32_t a = pending.back();
+          pending.pop_back();
+          for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
+            const std::uint32_t b = adj[k];
+            if (vchart[b] == kNone && region[b] == Region::Bone && owner[b] == owner[v])
+              vchart[b] = id, pending.push_back(b), piece.push_back(b);
+          }
         }
-        vchart[v] = c;
+        if (piece.size() < kMinBonePiece) {
+          maps.pop_back();
+          for (std::uint32_t a : piece) vchart[a] = kNone, region[a] = Region::Joint, owner[a] = kNone;
+        }
       } else if (region[v] == Region::Cap) {
         std::uint32_t& c = cap_chart[owner[v]];
         if (c == kNone) {
@@ -475,6 +499,27 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         vchart[v] = c;
       } else {
         vchart[v] = kNone;
+      }
+    }
+    // A bone piece whose vertices leave a gap of over a quarter turn around the bone does not
+    // wrap: its x spans the used sector, with the angle origin in the middle of the gap.
+    {
+      std::vector<std::vector<double>> angles(maps.size());
+      for (std::size_t v = 0; v < V; ++v)
+        if (region[v] == Region::Bone && vchart[v] != kNone)
+          angles[vchart[v]].push_back(local_coords(maps[vchart[v]], B, glm::dvec3(mesh.positions[v])).x /
+                                      std::max(maps[vchart[v]].width, 1e-300) * kTwoPi);
+      for (std::size_t c = 0; c < maps.size(); ++c) {
+        if (maps[c].kind != Chart::Kind::Bone || angles[c].size() < 2) continue;
+        auto& a = angles[c];
+        std::sort(a.begin(), a.end());
+        double gap = a.front() + kTwoPi - a.back(), mid = a.back() + gap / 2;
+        for (std::size_t i = 1; i < a.size(); ++i)
+          if (a[i] - a[i - 1] > gap) gap = a[i] - a[i - 1], mid = a[i - 1] + gap / 2;
+        if (gap > kTwoPi / 4) {
+          maps[c].wraps = false;
+          maps[c].angle0 = std::fmod(mid, kTwoPi);
+        }
       }
     }
     // Cap radius: mean distance of its vertices to the centre.
@@ -602,7 +647,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       uv[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
       if (vchart[t[k]] == c && vchart[t[ref]] != c) ref = k;
     }
-    if (maps[c].kind == Chart::Kind::Bone && maps[c].width > 0) {
+    if (maps[c].kind == Chart::Kind::Bone && maps[c].wraps && maps[c].width > 0) {
       unwrap(uv, ref, maps[c].width);
       // Keep the triangle overlapping [0, width): shift it whole when it fell outside.
       const double w = maps[c].width;
@@ -681,7 +726,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     m.hi = glm::max(m.hi, vlocal[v]);
   }
   for (ChartMap& m : maps)
-    if (m.kind == Chart::Kind::Bone) m.lo.x = 0, m.hi.x = m.width;
+    if (m.kind == Chart::Kind::Bone && m.wraps) m.lo.x = 0, m.hi.x = m.width;
 
   // 6. Scale and packing: the largest texels-per-unit at which the shelf packing fits.
   const std::size_t C = maps.size();
@@ -694,7 +739,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       const ChartMap& m = maps[c];
       const double ex = (m.hi.x - m.lo.x) * tpu, ey = (m.hi.y - m.lo.y) * tpu;
       const double cap = 1e9;
-      w[c] = m.kind == Chart::Kind::Bone ? static_cast<std::uint32_t>(std::max(3.0, std::min(cap, std::round(ex))))
+      w[c] = m.kind == Chart::Kind::Bone && m.wraps ? static_cast<std::uint32_t>(std::max(3.0, std::min(cap, std::round(ex))))
                                          : static_cast<std::uint32_t>(std::min(cap, std::ceil(ex)) + 1);
       h[c] = static_cast<std::uint32_t>(std::min(cap, std::ceil(ey)) + 1);
     }
@@ -731,7 +776,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     ch.y0 = best.y[c];
     ch.width = best.w[c];
     ch.height = best.h[c];
-    ch.wraps_x = maps[c].kind == Chart::Kind::Bone;
+    ch.wraps_x = maps[c].kind == Chart::Kind::Bone && maps[c].wraps;
   }
   const auto to_texel = [&](std::uint32_t c, const glm::dvec2& q) {
     const ChartMap& m = maps[c];
@@ -836,6 +881,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       overlapped += ql.charts[c].overlapped;
     }
     ql.overlap = covered > 0 ? static_cast<double>(overlapped) / static_cast<double>(covered) : 0.0;
+    ql.atlas_covered = static_cast<double>(covered) / (static_cast<double>(am.size) * am.size);
   }
   double used = 0;
   for (std::size_t c = 0; c < C; ++c) {

@@ -10,7 +10,10 @@
 //  - Bone: one per skeleton segment between joints (a chain of curve nodes of degree 2 between
 //    nodes of degree != 2). A vertex is parameterized by its closest point on the segment's
 //    polyline: y = arc length, x = angle around the polyline in a rotation-minimizing frame,
-//    scaled by the median distance of the chart's vertices to the polyline (x wraps).
+//    scaled by the median distance of the bone's vertices to the polyline. x wraps, except for a
+//    piece of a bone's region that leaves over a quarter turn unused: its x spans the used
+//    sector. A bone region cut in pieces (by the demotions below) is one chart per piece;
+//    pieces under 12 vertices go to planar joint charts.
 //  - Joint: at a leaf (end cap: azimuthal equidistant projection around the bone's direction)
 //    and, as planar projections, at junctions and wherever a bone chart would fold (closest point
 //    at a segment's end, surface normal along the bone, vertex on the polyline, a stretched or
@@ -74,6 +77,7 @@ struct ChartQuality {
 struct StmQuality {
   std::vector<ChartQuality> charts;
   double atlas_used = 0;           // share of the atlas inside chart rectangles
+  double atlas_covered = 0;        // share of the atlas whose texel centres atlas triangles cover
   double texels_per_unit = 0;      // the atlas scale: texels per model unit
   std::uint32_t bone_charts = 0, joint_charts = 0, sheet_charts = 0;
   double bone_vertex_share = 0;    // share of vertices in bone charts
