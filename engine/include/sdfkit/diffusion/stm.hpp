@@ -6,7 +6,7 @@
 //                                     atlas position per vertex, the triangles to rasterize)
 //                                     + StmQuality (distortion per chart, atlas share used)
 //
-// Charts (engine/diffusion/README.md has the details):
+// Charts (the steps in order: the opening comment of engine/diffusion/stm.cpp):
 //  - Bone: one per skeleton segment between joints (a chain of curve nodes of degree 2 between
 //    nodes of degree != 2). A vertex is parameterized by its closest point on the segment's
 //    polyline: y = arc length, x = angle around the polyline in a rotation-minimizing frame,
