@@ -8,8 +8,8 @@
 //
 // Charts (the steps in order: the opening comment of engine/diffusion/stm.cpp):
 //  - Bone: one per skeleton segment between joints (a chain of curve nodes of degree 2 between
-//    nodes of degree != 2). A vertex is parameterized by its closest point on the segment's
-//    polyline: y = arc length, x = angle around the polyline in a rotation-minimizing frame,
+//    nodes of degree != 2). A vertex is parameterized by the point of the segment's polyline
+//    it projects to (between the planes bisecting the bends, so continuous there): y = arc length, x = angle around the polyline in a rotation-minimizing frame,
 //    scaled by the median distance of the bone's vertices to the polyline. x wraps, except for a
 //    piece of a bone's region that leaves over a quarter turn unused: its x spans the used
 //    sector. A bone region cut in pieces (by the demotions below) is one chart per piece;
