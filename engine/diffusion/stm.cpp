@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -25,6 +26,8 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr double kTwoPi = 6.283185307179586;
 // Angle distortion of a triangle mapped to a segment or point (σ2 = 0), and the cap of all.
 constexpr double kMaxAngleDistortion = 1000.0;
+// A connected piece of a bone's region with fewer vertices than this is charted as a planar joint.
+constexpr std::size_t kMinBonePiece = 12;
 
 // A skeleton segment between joints: the polyline through its nodes' positions, arc length at
 // each point, and a rotation-minimizing frame (n, b) per segment (double reflection, Wang et al.
@@ -151,7 +154,9 @@ enum class Region : std::uint8_t { Bone, Cap, Joint, Sheet };
 struct ChartMap {
   Chart::Kind kind = Chart::Kind::Bone;
   std::uint32_t bone = kNone;   // Bone: index into bones
-  double width = 0;             // Bone: 2π × radius (x wraps there)
+  double width = 0;             // Bone: 2π × radius (x wraps there when `wraps`)
+  double angle0 = 0;            // Bone: the angle at x = 0
+  bool wraps = true;            // Bone: the piece goes all around (else x spans the used sector)
   glm::dvec3 origin{0.0}, axis{0.0}, b1{0.0}, b2{0.0};  // Cap / planar
   double cap_radius = 0;        // Cap: ρ = polar angle × cap_radius
   bool cap = false;
@@ -163,7 +168,9 @@ glm::dvec2 local_coords(const ChartMap& c, const std::vector<Bone>& bones, const
   if (c.kind == Chart::Kind::Bone) {
     const Bone& bone = bones[c.bone];
     const BonePoint bp = closest_on_bone(bone, p);
-    return {bone_angle(bone, bp.seg, bp.radial) / kTwoPi * c.width, bp.s};
+    double a = bone_angle(bone, bp.seg, bp.radial) - c.angle0;
+    if (a < 0) a += kTwoPi;
+    return {a / kTwoPi * c.width, bp.s};
   }
   const glm::dvec3 q = p - c.origin;
   if (c.cap) {
@@ -441,19 +448,37 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
   const auto build_charts = [&] {
     maps.clear();
     bone_radii();
-    std::vector<std::uint32_t> bone_chart(B.size(), kNone), cap_chart(N, kNone);
+    std::vector<std::uint32_t> cap_chart(N, kNone);
+    std::fill(vchart.begin(), vchart.end(), kNone);
+    std::vector<std::uint32_t> pending;
     for (std::size_t v = 0; v < V; ++v) {
       if (region[v] == Region::Bone) {
-        std::uint32_t& c = bone_chart[owner[v]];
-        if (c == kNone) {
-          ChartMap m;
-          m.kind = Chart::Kind::Bone;
-          m.bone = owner[v];
-          m.width = kTwoPi * B[owner[v]].radius;
-          c = static_cast<std::uint32_t>(maps.size());
-          maps.push_back(m);
+        // One chart per connected piece of a bone's vertices (demotions can cut a bone's region
+        // in two; one rectangle over both would be mostly empty).
+        // Pieces of fewer than kMinBonePiece vertices join the planar joint regions.
+        if (vchart[v] != kNone) continue;
+        ChartMap m;
+        m.kind = Chart::Kind::Bone;
+        m.bone = owner[v];
+        m.width = kTwoPi * B[owner[v]].radius;
+        const auto id = static_cast<std::uint32_t>(maps.size());
+        maps.push_back(m);
+        vchart[v] = id;
+        std::vector<std::uint32_t> piece{static_cast<std::uint32_t>(v)};
+        pending = {static_cast<std::uint32_t>(v)};
+        while (!pending.empty()) {
+          const std::uint32_t a = pending.back();
+          pending.pop_back();
+          for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
+            const std::uint32_t b = adj[k];
+            if (vchart[b] == kNone && region[b] == Region::Bone && owner[b] == owner[v])
+              vchart[b] = id, pending.push_back(b), piece.push_back(b);
+          }
         }
-        vchart[v] = c;
+        if (piece.size() < kMinBonePiece) {
+          maps.pop_back();
+          for (std::uint32_t a : piece) vchart[a] = kNone, region[a] = Region::Joint, owner[a] = kNone;
+        }
       } else if (region[v] == Region::Cap) {
         std::uint32_t& c = cap_chart[owner[v]];
         if (c == kNone) {
@@ -474,6 +499,27 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         vchart[v] = c;
       } else {
         vchart[v] = kNone;
+      }
+    }
+    // A bone piece whose vertices leave a gap of over a quarter turn around the bone does not
+    // wrap: its x spans the used sector, with the angle origin in the middle of the gap.
+    {
+      std::vector<std::vector<double>> angles(maps.size());
+      for (std::size_t v = 0; v < V; ++v)
+        if (region[v] == Region::Bone && vchart[v] != kNone)
+          angles[vchart[v]].push_back(local_coords(maps[vchart[v]], B, glm::dvec3(mesh.positions[v])).x /
+                                      std::max(maps[vchart[v]].width, 1e-300) * kTwoPi);
+      for (std::size_t c = 0; c < maps.size(); ++c) {
+        if (maps[c].kind != Chart::Kind::Bone || angles[c].size() < 2) continue;
+        auto& a = angles[c];
+        std::sort(a.begin(), a.end());
+        double gap = a.front() + kTwoPi - a.back(), mid = a.back() + gap / 2;
+        for (std::size_t i = 1; i < a.size(); ++i)
+          if (a[i] - a[i - 1] > gap) gap = a[i] - a[i - 1], mid = a[i - 1] + gap / 2;
+        if (gap > kTwoPi / 4) {
+          maps[c].wraps = false;
+          maps[c].angle0 = std::fmod(mid, kTwoPi);
+        }
       }
     }
     // Cap radius: mean distance of its vertices to the centre.
@@ -567,6 +613,31 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     }
   };
 
+  // Turns every planar chart's (b1, b2) to the principal axes of its vertices' projections, so
+  // its rectangle (the bounding box) wastes less of the atlas on elongated, diagonal pieces.
+  const auto align_planar_charts = [&] {
+    std::vector<std::array<double, 6>> acc(maps.size(), {0, 0, 0, 0, 0, 0});  // n, x, y, xx, yy, xy
+    for (std::size_t v = 0; v < V; ++v) {
+      const ChartMap& m = maps[vchart[v]];
+      if (m.kind == Chart::Kind::Bone || m.cap) continue;
+      const glm::dvec3 p(mesh.positions[v]);
+      const double x = glm::dot(p, m.b1), y = glm::dot(p, m.b2);
+      auto& a = acc[vchart[v]];
+      a[0] += 1, a[1] += x, a[2] += y, a[3] += x * x, a[4] += y * y, a[5] += x * y;
+    }
+    for (std::size_t c = 0; c < maps.size(); ++c) {
+      const auto& a = acc[c];
+      if (a[0] < 3) continue;
+      const double mx = a[1] / a[0], my = a[2] / a[0];
+      const double cxx = a[3] / a[0] - mx * mx, cyy = a[4] / a[0] - my * my, cxy = a[5] / a[0] - mx * my;
+      const double angle = 0.5 * std::atan2(2 * cxy, cxx - cyy);
+      ChartMap& m = maps[c];
+      const glm::dvec3 b1 = std::cos(angle) * m.b1 + std::sin(angle) * m.b2;
+      m.b1 = glm::normalize(b1);
+      m.b2 = glm::cross(m.axis, m.b1);
+    }
+  };
+
   // Local corners of face f in chart c (model units), wrapping charts unwrapped toward the
   // first corner that belongs to c (or corner 0).
   const auto face_local = [&](std::size_t f, std::uint32_t c, glm::dvec2 (&uv)[3]) {
@@ -576,7 +647,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       uv[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
       if (vchart[t[k]] == c && vchart[t[ref]] != c) ref = k;
     }
-    if (maps[c].kind == Chart::Kind::Bone && maps[c].width > 0) {
+    if (maps[c].kind == Chart::Kind::Bone && maps[c].wraps && maps[c].width > 0) {
       unwrap(uv, ref, maps[c].width);
       // Keep the triangle overlapping [0, width): shift it whole when it fell outside.
       const double w = maps[c].width;
@@ -627,6 +698,8 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     if (round == 11) build_charts();
   }
 
+  align_planar_charts();
+
   // 5. Atlas triangles in local coordinates; chart extents.
   struct LocalTri {
     std::uint32_t chart, face;
@@ -653,7 +726,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     m.hi = glm::max(m.hi, vlocal[v]);
   }
   for (ChartMap& m : maps)
-    if (m.kind == Chart::Kind::Bone) m.lo.x = 0, m.hi.x = m.width;
+    if (m.kind == Chart::Kind::Bone && m.wraps) m.lo.x = 0, m.hi.x = m.width;
 
   // 6. Scale and packing: the largest texels-per-unit at which the shelf packing fits.
   const std::size_t C = maps.size();
@@ -666,7 +739,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       const ChartMap& m = maps[c];
       const double ex = (m.hi.x - m.lo.x) * tpu, ey = (m.hi.y - m.lo.y) * tpu;
       const double cap = 1e9;
-      w[c] = m.kind == Chart::Kind::Bone ? static_cast<std::uint32_t>(std::max(3.0, std::min(cap, std::round(ex))))
+      w[c] = m.kind == Chart::Kind::Bone && m.wraps ? static_cast<std::uint32_t>(std::max(3.0, std::min(cap, std::round(ex))))
                                          : static_cast<std::uint32_t>(std::min(cap, std::ceil(ex)) + 1);
       h[c] = static_cast<std::uint32_t>(std::min(cap, std::ceil(ey)) + 1);
     }
@@ -703,7 +776,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     ch.y0 = best.y[c];
     ch.width = best.w[c];
     ch.height = best.h[c];
-    ch.wraps_x = maps[c].kind == Chart::Kind::Bone;
+    ch.wraps_x = maps[c].kind == Chart::Kind::Bone && maps[c].wraps;
   }
   const auto to_texel = [&](std::uint32_t c, const glm::dvec2& q) {
     const ChartMap& m = maps[c];
@@ -769,6 +842,47 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     all_area.push_back({ad, area});
     all_angle.push_back({gd, area});
   }
+  // Coverage: texel centres inside each atlas triangle (wrapping charts: also shifted by ±width),
+  // counted per texel.
+  {
+    std::vector<std::uint8_t> count(static_cast<std::size_t>(am.size) * am.size, 0);
+    for (const AtlasTriangle& at : am.triangles) {
+      const Chart& ch = am.charts[at.chart];
+      for (int sh = ch.wraps_x ? -1 : 0; sh <= (ch.wraps_x ? 1 : 0); ++sh) {
+        glm::dvec2 a(at.uv[0]), b(at.uv[1]), c(at.uv[2]);
+        a.x += sh * double(ch.width), b.x += sh * double(ch.width), c.x += sh * double(ch.width);
+        const double den = signed_area2(a, b, c);
+        if (den == 0) continue;
+        const long x0 = std::max<long>(ch.x0, static_cast<long>(std::floor(std::min({a.x, b.x, c.x}))));
+        const long x1 = std::min<long>(ch.x0 + ch.width - 1, static_cast<long>(std::floor(std::max({a.x, b.x, c.x}))));
+        const long y0 = std::max<long>(ch.y0, static_cast<long>(std::floor(std::min({a.y, b.y, c.y}))));
+        const long y1 = std::min<long>(ch.y0 + ch.height - 1, static_cast<long>(std::floor(std::max({a.y, b.y, c.y}))));
+        for (long y = y0; y <= y1; ++y)
+          for (long x = x0; x <= x1; ++x) {
+            const glm::dvec2 p(x + 0.5, y + 0.5);
+            const double w0 = signed_area2(b, c, p) / den, w1 = signed_area2(c, a, p) / den, w2 = 1 - w0 - w1;
+            // Half-open on shared edges (a texel centre exactly on an edge counts once).
+            if (w0 < 0 || w1 < 0 || w2 <= 0) continue;
+            std::uint8_t& k = count[static_cast<std::size_t>(y) * am.size + static_cast<std::size_t>(x)];
+            if (k < 255) ++k;
+          }
+      }
+    }
+    std::uint64_t covered = 0, overlapped = 0;
+    for (std::size_t c = 0; c < C; ++c) {
+      const Chart& ch = am.charts[c];
+      for (std::size_t y = ch.y0; y < ch.y0 + ch.height; ++y)
+        for (std::size_t x = ch.x0; x < ch.x0 + ch.width; ++x) {
+          const std::uint8_t k = count[y * am.size + x];
+          ql.charts[c].covered += k > 0;
+          ql.charts[c].overlapped += k > 1;
+        }
+      covered += ql.charts[c].covered;
+      overlapped += ql.charts[c].overlapped;
+    }
+    ql.overlap = covered > 0 ? static_cast<double>(overlapped) / static_cast<double>(covered) : 0.0;
+    ql.atlas_covered = static_cast<double>(covered) / (static_cast<double>(am.size) * am.size);
+  }
   double used = 0;
   for (std::size_t c = 0; c < C; ++c) {
     ChartQuality& cq = ql.charts[c];
@@ -792,11 +906,27 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
   return out;
 }
 
-std::vector<glm::vec2> normalized_vertex_uv(const AtlasMapping& mapping) {
-  std::vector<glm::vec2> uv(mapping.vertex_uv.size());
+std::vector<std::array<glm::vec2, 3>> gltf_corner_uv(const AtlasMapping& mapping, const Mesh& mesh) {
+  const std::size_t F = mesh.triangles.size();
+  if (mapping.vertex_chart.size() != mesh.positions.size())
+    throw InputError("TEXCOORD_1: the atlas mapping does not fit the mesh's vertices");
+  std::vector<std::uint32_t> want(F);
+  for (std::size_t f = 0; f < F; ++f) {
+    const Triangle& t = mesh.triangles[f];
+    const std::uint32_t a = mapping.vertex_chart[t[0]], b = mapping.vertex_chart[t[1]], c = mapping.vertex_chart[t[2]];
+    want[f] = (b == c && b != a) ? b : a;
+  }
+  std::vector<std::array<glm::vec2, 3>> out(F);
+  std::vector<std::uint8_t> found(F, 0);
   const float s = static_cast<float>(mapping.size);
-  for (std::size_t i = 0; i < uv.size(); ++i) uv[i] = mapping.vertex_uv[i] / s;
-  return uv;
+  for (const AtlasTriangle& at : mapping.triangles) {
+    if (at.face >= F || at.chart != want[at.face] || found[at.face]) continue;
+    found[at.face] = 1;
+    for (int k = 0; k < 3; ++k) out[at.face][static_cast<std::size_t>(k)] = {at.uv[k].x / s, 1.0f - at.uv[k].y / s};
+  }
+  for (std::size_t f = 0; f < F; ++f)
+    if (!found[f]) throw InputError("TEXCOORD_1: face " + std::to_string(f) + " has no atlas triangle in its chart");
+  return out;
 }
 
 }  // namespace sdfkit::diffusion

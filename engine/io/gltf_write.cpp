@@ -17,6 +17,7 @@
 #include <cctype>
 #include <cstring>
 #include <map>
+#include <tuple>
 #include <ostream>
 #include <utility>
 
@@ -274,6 +275,34 @@ tinygltf::Model write_back_model(const GltfSource& src, bool binary, const Outpu
   return model;
 }
 
+// With a TEXCOORD_1 per triangle corner: one output vertex per (input vertex, UV) pair, in order
+// of first use (input vertices no triangle uses keep one vertex with UV (0, 0)); `source` maps
+// each output vertex to its input vertex.
+struct SplitVertices {
+  std::vector<std::uint32_t> source;
+  std::vector<glm::vec2> uv;
+  std::vector<Triangle> triangles;
+};
+
+SplitVertices split_by_corner_uv(const Asset& asset, const std::vector<std::array<glm::vec2, 3>>& corner_uv) {
+  SplitVertices out;
+  std::map<std::tuple<std::uint32_t, float, float>, std::uint32_t> index;
+  std::vector<std::uint8_t> used(asset.input_positions.size(), 0);
+  out.triangles.resize(asset.input_triangles.size());
+  for (std::size_t f = 0; f < asset.input_triangles.size(); ++f)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t v = asset.input_triangles[f][k];
+      const glm::vec2 uv = corner_uv[f][k];
+      const auto [it, added] = index.emplace(std::make_tuple(v, uv.x, uv.y), static_cast<std::uint32_t>(out.source.size()));
+      if (added) out.source.push_back(v), out.uv.push_back(uv);
+      out.triangles[f][k] = it->second;
+      used[v] = 1;
+    }
+  for (std::uint32_t v = 0; v < used.size(); ++v)
+    if (!used[v]) out.source.push_back(v), out.uv.push_back(glm::vec2(0.0f));
+  return out;
+}
+
 tinygltf::Model fresh_model(const Asset& asset, const OutputValues& values,
                             const WriteOptions& options) {
   tinygltf::Model model;
@@ -281,15 +310,38 @@ tinygltf::Model fresh_model(const Asset& asset, const OutputValues& values,
   model.asset.generator = "sdfkit";
   model.buffers.emplace_back();
   BufferAppender appender(model);
-  const std::size_t nv = asset.input_positions.size();
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
-  prim.attributes["POSITION"] = appender.add_floats(
-      &asset.input_positions[0].x, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
-  prim.indices =
-      appender.add_indices(asset.input_triangles.data()->data(), asset.input_triangles.size() * 3);
-  add_sdf_attributes(appender, prim,
-                     slice(values, 0, static_cast<std::uint32_t>(nv), options.color), nv);
+  if (!options.texcoord1.empty()) {
+    const SplitVertices split = split_by_corner_uv(asset, options.texcoord1);
+    const std::size_t nv = split.source.size();
+    std::vector<glm::vec3> positions(nv);
+    OutputValues copied;
+    copied.raw.resize(nv);
+    copied.normalized.resize(nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      positions[i] = asset.input_positions[split.source[i]];
+      copied.raw[i] = values.raw[split.source[i]];
+      copied.normalized[i] = values.normalized[split.source[i]];
+    }
+    prim.attributes["POSITION"] =
+        appender.add_floats(&positions[0].x, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
+    // glTF numbers UV sets from 0 without gaps: a fresh asset has no set of its own, so
+    // TEXCOORD_0 is the same accessor.
+    prim.attributes["TEXCOORD_1"] =
+        appender.add_floats(&split.uv[0].x, nv, TINYGLTF_TYPE_VEC2, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+    prim.attributes["TEXCOORD_0"] = prim.attributes["TEXCOORD_1"];
+    prim.indices = appender.add_indices(split.triangles.data()->data(), split.triangles.size() * 3);
+    add_sdf_attributes(appender, prim, slice(copied, 0, static_cast<std::uint32_t>(nv), options.color), nv);
+  } else {
+    const std::size_t nv = asset.input_positions.size();
+    prim.attributes["POSITION"] = appender.add_floats(
+        &asset.input_positions[0].x, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
+    prim.indices =
+        appender.add_indices(asset.input_triangles.data()->data(), asset.input_triangles.size() * 3);
+    add_sdf_attributes(appender, prim,
+                       slice(values, 0, static_cast<std::uint32_t>(nv), options.color), nv);
+  }
   tinygltf::Mesh mesh;
   mesh.primitives.push_back(std::move(prim));
   model.meshes.push_back(std::move(mesh));
@@ -356,6 +408,7 @@ void add_overlays(tinygltf::Model& model, const std::vector<Overlay>& overlays) 
 void write_gltf(std::ostream& out, bool binary, const Asset& asset, const OutputValues& values,
                 const WriteOptions& options, std::vector<std::string>& warnings) {
   static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  static_assert(sizeof(glm::vec2) == 2 * sizeof(float));
   static_assert(sizeof(Triangle) == 3 * sizeof(std::uint32_t));
   const auto* src = (asset.format == Format::Gltf || asset.format == Format::Glb)
                         ? static_cast<const GltfSource*>(asset.source.get())

@@ -215,6 +215,20 @@ void write_field(const std::string& out_path, const Asset& asset, const SdfField
     throw InputError(out_path + ": the asset's input-to-welded map does not match its vertices");
   if (!per_vertex && asset.input_triangles.size() != asset.mesh.face_count())
     throw InputError(out_path + ": the asset's input triangles do not match its mesh");
+  if (!options.texcoord1.empty()) {
+    if (format != Format::Gltf && format != Format::Glb)
+      throw UsageError(out_path + ": a TEXCOORD_1 UV set can only be written to .gltf or .glb");
+    if (asset.format == Format::Gltf || asset.format == Format::Glb)
+      throw UsageError(out_path + ": a TEXCOORD_1 UV set is only written into a fresh glTF (the input is a glTF "
+                       "asset, whose primitives would have to be split at the atlas's chart borders)");
+    if (options.texcoord1.size() != asset.input_triangles.size())
+      throw InputError(out_path + ": " + std::to_string(options.texcoord1.size()) + " TEXCOORD_1 triangles for " +
+                       std::to_string(asset.input_triangles.size()) + " input triangles");
+    for (const auto& t : options.texcoord1)
+      for (const glm::vec2& uv : t)
+        if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
+          throw InputError(out_path + ": a TEXCOORD_1 coordinate is not finite");
+  }
 
   // Values in input order: per input vertex through the weld map; faces keep their order.
   detail::OutputValues values;

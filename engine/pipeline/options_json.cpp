@@ -27,7 +27,7 @@ constexpr std::size_t member_count() {
 static_assert(member_count<SdfOptions>() == 4, "SdfOptions: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<BackendConfig>() == 10, "BackendConfig: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<io::LoadOptions>() == 4, "io::LoadOptions: options_to_json must write every member (the batch fingerprint is made of it)");
-static_assert(member_count<io::WriteOptions>() == 3, "io::WriteOptions: options_to_json must write every member (the batch fingerprint is made of it)");
+static_assert(member_count<io::WriteOptions>() == 4, "io::WriteOptions: options_to_json must write every member (the batch fingerprint is made of it)");
 static_assert(member_count<ComputeRequest>() == 8, "ComputeRequest: options_to_json must write every member (the batch fingerprint is made of it)");
 
 // FNV-1a over the overlays' bytes: they are data, not settings, and may be large.
@@ -56,6 +56,14 @@ nlohmann::json options_object_base(const ComputeRequest& r) {
                         {"lines", o.lines.size()},
                         {"triangles", o.triangles.size()},
                         {"digest", overlay_digest(o)}});
+  nlohmann::json write = {{"color", r.write.color}, {"normalized", r.write.normalized}, {"overlays", overlays}};
+  // Written only when set, so that fingerprints of jobs without it stay what they were.
+  if (!r.write.texcoord1.empty()) {
+    io::Overlay uv;  // digest of the corner UVs through the overlay digest's byte mixer
+    for (const auto& t : r.write.texcoord1)
+      for (const glm::vec2& q : t) uv.points.push_back({q.x, q.y, 0.0f});
+    write["texcoord1"] = {{"triangles", r.write.texcoord1.size()}, {"digest", overlay_digest(uv)}};
+  }
   return {
       {"backend",
        {{"kind", to_string(b.kind)},
@@ -78,7 +86,7 @@ nlohmann::json options_object_base(const ComputeRequest& r) {
         {"allow_external_paths", r.load.allow_external_paths},
         {"max_triangles", r.load.max_triangles},
         {"max_file_size", r.load.max_file_size}}},
-      {"write", {{"color", r.write.color}, {"normalized", r.write.normalized}, {"overlays", overlays}}},
+      {"write", write},
       {"smooth_rings", r.smooth_rings}};
 }
 

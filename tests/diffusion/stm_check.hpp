@@ -99,6 +99,8 @@ inline void expect_valid_stm(const Mesh& mesh, const diffusion::Stm& stm, const 
   const diffusion::StmQuality& q = stm.quality;
   EXPECT_GT(q.atlas_used, 0.0);
   EXPECT_LE(q.atlas_used, 1.0);
+  EXPECT_GT(q.atlas_covered, 0.0);
+  EXPECT_LE(q.atlas_covered, q.atlas_used);
   for (const diffusion::ChartQuality& cq : q.charts) {
     EXPECT_TRUE(std::isfinite(cq.area_distortion.mean) && std::isfinite(cq.area_distortion.max));
     EXPECT_TRUE(std::isfinite(cq.angle_distortion.mean));

@@ -87,6 +87,7 @@ TEST(Stm, CapsuleIsOneIsometricBoneChartAndTwoCaps) {
     EXPECT_LE(c.angle_distortion.max, M_PI / 2 * 1.05);
   }
   EXPECT_GT(stm.quality.atlas_used, 0.3) << "the shelf packing of three rectangles";
+  EXPECT_LT(stm.quality.overlap, 1e-3) << "no chart folds over itself";
 }
 
 TEST(Stm, BoneChartWrapsAndSeamTrianglesAreUnwrapped) {

@@ -6,11 +6,14 @@
 //                                     atlas position per vertex, the triangles to rasterize)
 //                                     + StmQuality (distortion per chart, atlas share used)
 //
-// Charts (engine/diffusion/README.md has the details):
+// Charts (the steps in order: the opening comment of engine/diffusion/stm.cpp):
 //  - Bone: one per skeleton segment between joints (a chain of curve nodes of degree 2 between
-//    nodes of degree != 2). A vertex is parameterized by its closest point on the segment's
-//    polyline: y = arc length, x = angle around the polyline in a rotation-minimizing frame,
-//    scaled by the median distance of the chart's vertices to the polyline (x wraps).
+//    nodes of degree != 2). A vertex is parameterized by the point of the segment's polyline
+//    it projects to (between the planes bisecting the bends, so continuous there): y = arc length, x = angle around the polyline in a rotation-minimizing frame,
+//    scaled by the median distance of the bone's vertices to the polyline. x wraps, except for a
+//    piece of a bone's region that leaves over a quarter turn unused: its x spans the used
+//    sector. A bone region cut in pieces (by the demotions below) is one chart per piece;
+//    pieces under 12 vertices go to planar joint charts.
 //  - Joint: at a leaf (end cap: azimuthal equidistant projection around the bone's direction)
 //    and, as planar projections, at junctions and wherever a bone chart would fold (closest point
 //    at a segment's end, surface normal along the bone, vertex on the polyline, a stretched or
@@ -31,6 +34,7 @@
 #include "sdfkit/diffusion/atlas.hpp"
 #include "sdfkit/skeleton/skeleton.hpp"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -61,6 +65,7 @@ struct ChartQuality {
   std::uint32_t triangles = 0;   // atlas triangles in the chart (own and duplicated)
   double area = 0;               // model area of the faces whose corners are all in the chart
   std::uint64_t texels = 0;      // width × height of the rectangle
+  std::uint64_t covered = 0, overlapped = 0;  // texels covered by its triangles; by more than one
   // Per triangle, from the singular values σ1 ≥ σ2 of the map model surface → atlas, in units of
   // the atlas scale (texels_per_unit of the whole atlas): area distortion σ1σ2 (1 = the same
   // texel density everywhere) and angle distortion σ1/σ2 (1 = conformal). Over the faces whose
@@ -72,10 +77,15 @@ struct ChartQuality {
 struct StmQuality {
   std::vector<ChartQuality> charts;
   double atlas_used = 0;           // share of the atlas inside chart rectangles
+  double atlas_covered = 0;        // share of the atlas whose texel centres atlas triangles cover
   double texels_per_unit = 0;      // the atlas scale: texels per model unit
   std::uint32_t bone_charts = 0, joint_charts = 0, sheet_charts = 0;
   double bone_vertex_share = 0;    // share of vertices in bone charts
   std::uint64_t duplicated_triangles = 0;  // atlas triangles beyond one per face
+  // Share of the texels that atlas triangles cover (texel centres inside) covered by more than one
+  // of them: a chart folding over itself (a planar projection of a non-convex piece, a bone
+  // chart at a sharp bend) - there, two parts of the surface share texels and the blur mixes them.
+  double overlap = 0;
   // The same statistics over every chart's faces together (area weighted).
   Stats area_distortion, angle_distortion;
   double seconds = 0;              // wall-clock time of build_stm
@@ -105,8 +115,13 @@ skeleton::Skeleton parse_skeleton_json(const std::string& text, const std::strin
 void write_atlas_png(const AtlasMapping& mapping, const Mesh& mesh, std::span<const float> vertex_values,
                      const std::string& path);
 
-// The mapping as one per-vertex UV set in [0,1]² (atlas texels / size, v = 0 at the atlas's
-// bottom row as in atlas.hpp; glTF flips v when writing TEXCOORD_1): vertex_uv / size.
-std::vector<glm::vec2> normalized_vertex_uv(const AtlasMapping& mapping);
+// The mapping as glTF's TEXCOORD_1 (io::WriteOptions::texcoord1): per mesh face, its corners'
+// UVs in the chart that holds most of its vertices (a tie: its first vertex's chart), taken from
+// that chart's atlas triangle, normalized to [0,1]² with v = 0 at the top, so that the PNG of
+// write_atlas_png is the texture they address. Corners of one face are always in one chart, so
+// no triangle interpolates across the atlas; the glTF writer splits vertices where the faces
+// around them use different charts. A face across a wrapping chart's seam keeps its unwrapped
+// corners: it reaches past the rectangle's edge by less than its own width, into the gutter.
+std::vector<std::array<glm::vec2, 3>> gltf_corner_uv(const AtlasMapping& mapping, const Mesh& mesh);
 
 }  // namespace sdfkit::diffusion

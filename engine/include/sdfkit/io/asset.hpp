@@ -9,6 +9,7 @@
 #include "sdfkit/core/mesh.hpp"
 #include "sdfkit/core/sdf.hpp"
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include <cstdint>
@@ -109,6 +110,16 @@ struct WriteOptions {
   bool color = true;        // glTF COLOR_0, PLY red/green/blue from colormap(normalized value)
   bool normalized = false;  // .txt and PLY quality hold the [0,1] normalized value
   std::vector<Overlay> overlays;  // glTF only
+  // A second UV set (glTF TEXCOORD_1, e.g. a skeleton texture mapping's atlas): per input
+  // triangle, the UV of each of its corners, in glTF's convention ([0,1]², v = 0 at the top of
+  // the image). Per corner, not per vertex, so that a triangle never interpolates across two
+  // charts of an atlas: the writer splits every input vertex into one output vertex per distinct
+  // UV its corners have (positions, _SDF and COLOR_0 copied), so the output stays a valid glTF
+  // whose TEXCOORD_1 is continuous inside each chart. glTF numbers UV sets from 0 without gaps:
+  // the fresh asset has none of its own, so TEXCOORD_0 is the same accessor. Only for a fresh
+  // glTF (a non-glTF input): with a glTF input, PLY or txt output it is a UsageError. Empty: no
+  // TEXCOORD_1.
+  std::vector<std::array<glm::vec2, 3>> texcoord1;
 };
 
 // Throws InputError when a `domain` field cannot be written to `out_path` at all: unknown
