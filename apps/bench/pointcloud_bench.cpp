@@ -122,21 +122,26 @@ double median(std::vector<double> v) {
 }
 
 struct Summary {
-  std::map<std::string, std::vector<double>> steps;
-  std::vector<double> totals;
+  std::map<std::string, std::vector<double>> steps, cpu;
+  std::vector<double> totals, cpu_totals;
   void add(const pc::SkeletonResult& r) {
-    double t = 0.0;
+    double t = 0.0, c = 0.0;
     for (const auto& s : r.times) {
       steps[s.step].push_back(s.milliseconds);
+      cpu[s.step].push_back(s.cpu_milliseconds);
       t += s.milliseconds;
+      c += s.cpu_milliseconds;
     }
     totals.push_back(t);
+    cpu_totals.push_back(c);
   }
+  // Each cell: the median wall-clock ms (the median CPU ms of the process, both cores and
+  // PoCL's threads counted, in brackets).
   void print(const char* label, std::size_t points) const {
     std::printf("| %s | %zu |", label, points);
     for (const char* s : {"subsample", "neighbours", "normals", "orientation", "surface", "sdf", "shift", "clustering", "polyline"})
-      std::printf(" %.2f |", steps.count(s) ? median(steps.at(s)) : 0.0);
-    std::printf(" **%.1f** | %.1f |\n", median(totals), *std::max_element(totals.begin(), totals.end()));
+      std::printf(" %.2f (%.2f) |", steps.count(s) ? median(steps.at(s)) : 0.0, cpu.count(s) ? median(cpu.at(s)) : 0.0);
+    std::printf(" **%.1f** (%.1f) | %.1f |\n", median(totals), median(cpu_totals), *std::max_element(totals.begin(), totals.end()));
   }
 };
 
@@ -151,7 +156,7 @@ int main(int argc, char** argv) {
       "embree";
 #endif
   int segments = 16, runs = 1;
-  bool procrustes = true;
+  bool procrustes = true, worm_frames = true, cgal = true;
   std::vector<std::size_t> synthetic{2000, 30000};
   std::vector<int> bone_counts{4, 6, 8, 12, 16, 20, 24, 32};
   pc::SkeletonOptions opt;
@@ -168,6 +173,9 @@ int main(int argc, char** argv) {
     else if (a == "--runs") runs = std::stoi(next());
     else if (a == "--neighbours") opt.neighbours = std::stoi(next());
     else if (a == "--cluster-neighbours") opt.cluster_neighbours = std::stoi(next());
+    else if (a == "--no-median") opt.median = false;
+    else if (a == "--no-worm") worm_frames = false;
+    else if (a == "--no-cgal") cgal = false;
     else if (a == "--max-points") opt.max_points = std::stoul(next());
     else if (a == "--rays") opt.sdf.rays = std::stoi(next());
     else if (a == "--linkage") opt.linkage = next() == "single" ? pc::Linkage::Single : pc::Linkage::Average;
@@ -196,51 +204,57 @@ int main(int argc, char** argv) {
                 opt.linkage == pc::Linkage::Single ? "single" : "average");
     const pc::FrameSet set = pc::read_frames(data, true);
     const auto mid = read_midlines(data + "/midline.txt");
-    Summary worm;
-    std::vector<pc::Polyline> lines;
-    std::vector<double> err, err_sym;
-    std::size_t inexact = 0, ambiguous = 0;
-    for (int run = 0; run < runs; ++run) {
-      lines.clear();
-      for (std::size_t f = 0; f < set.frames.size(); ++f) {
-        pc::SkeletonResult r = pc::point_cloud_skeleton(set.frames[f], *backend, opt);
-        if (run == 0) {
-          inexact += !r.exact;
-          ambiguous += r.ambiguous.size();
-        }
-        worm.add(r);
-        lines.push_back(std::move(r.polyline));
-      }
-    }
-    pc::orient_sequence(lines);
-    std::size_t swaps = 0;
-    int first_end = 0;
-    double worst = 0.0, worst_sym = 0.0;
-    for (std::size_t f = 0; f < lines.size(); ++f) {
-      const float body = mid[f].length();
-      const double e = pc::mean_distance(lines[f], mid[f], 0.25f) / body;
-      const double es = 0.5 * (e + pc::mean_distance(mid[f], lines[f], 0.25f) / body);
-      err.push_back(e);
-      err_sym.push_back(es);
-      worst = std::max(worst, e);
-      worst_sym = std::max(worst_sym, es);
-      // Which end is first: +1 = the tail (slice 50), -1 = the head (slice 148).
-      const glm::vec3 p0 = lines[f].nodes.front().position;
-      const int end = glm::distance(p0, mid[f].nodes.front().position) < glm::distance(p0, mid[f].nodes.back().position) ? 1 : -1;
-      if (f == 0) first_end = end;
-      else if (end != first_end) ++swaps;
-    }
-    double mean = 0.0;
-    for (double e : err) mean += e;
-    mean /= static_cast<double>(err.size());
-    std::printf("worm: %zu frames x %zu points: polyline -> midline mean distance %.3f %% of the body length "
-                "(worst frame %.3f %%), symmetric worst %.3f %%; frames whose first node is not the same end as frame 0: %zu; "
-                "frames without exactly %d segments: %zu; ambiguous normals: %zu\n\n",
-                set.frames.size(), set.frames[0].size(), 100.0 * mean, 100.0 * worst, 100.0 * worst_sym, swaps,
-                segments, inexact, ambiguous);
+    std::printf("Each cell: median wall-clock ms (median process CPU ms, all threads)\n\n");
     std::printf("| cloud | points | subsample | neighbours | normals | orientation | surface | sdf | shift | clustering | polyline | total median ms | max ms |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    worm.print("Sibernetic worm (shell)", set.frames[0].size());
+    std::string accuracy;
+    if (worm_frames) {
+      Summary worm;
+      std::vector<pc::Polyline> lines;
+      std::vector<double> err, err_sym;
+      std::size_t inexact = 0, ambiguous = 0;
+      for (int run = 0; run < runs; ++run) {
+        lines.clear();
+        for (std::size_t f = 0; f < set.frames.size(); ++f) {
+          pc::SkeletonResult r = pc::point_cloud_skeleton(set.frames[f], *backend, opt);
+          if (run == 0) {
+            inexact += !r.exact;
+            ambiguous += r.ambiguous.size();
+          }
+          worm.add(r);
+          lines.push_back(std::move(r.polyline));
+        }
+      }
+      pc::orient_sequence(lines);
+      std::size_t swaps = 0;
+      int first_end = 0;
+      double worst = 0.0, worst_sym = 0.0;
+      for (std::size_t f = 0; f < lines.size(); ++f) {
+        const float body = mid[f].length();
+        const double e = pc::mean_distance(lines[f], mid[f], 0.25f) / body;
+        const double es = 0.5 * (e + pc::mean_distance(mid[f], lines[f], 0.25f) / body);
+        err.push_back(e);
+        err_sym.push_back(es);
+        worst = std::max(worst, e);
+        worst_sym = std::max(worst_sym, es);
+        // Which end is first: +1 = the tail (slice 50), -1 = the head (slice 148).
+        const glm::vec3 p0 = lines[f].nodes.front().position;
+        const int end = glm::distance(p0, mid[f].nodes.front().position) < glm::distance(p0, mid[f].nodes.back().position) ? 1 : -1;
+        if (f == 0) first_end = end;
+        else if (end != first_end) ++swaps;
+      }
+      double mean = 0.0;
+      for (double e : err) mean += e;
+      mean /= static_cast<double>(err.size());
+      char line[1024];
+      std::snprintf(line, sizeof line, "worm: %zu frames x %zu points: polyline -> midline mean distance %.3f %% of the body length "
+                  "(worst frame %.3f %%), symmetric worst %.3f %%; frames whose first node is not the same end as frame 0: %zu; "
+                  "frames without exactly %d segments: %zu; ambiguous normals: %zu\n\n",
+                  set.frames.size(), set.frames[0].size(), 100.0 * mean, 100.0 * worst, 100.0 * worst_sym, swaps,
+                  segments, inexact, ambiguous);
+      accuracy = line;
+      worm.print("Sibernetic worm (shell)", set.frames[0].size());
+    }
     for (std::size_t count : synthetic) {
       pc::WormShape shape;
       shape.points = count;
@@ -273,8 +287,9 @@ int main(int argc, char** argv) {
         ss.print(sl.c_str(), count);
       }
     }
+    if (!accuracy.empty()) std::printf("\n%s", accuracy.c_str());
 #ifdef SDFKIT_POINTCLOUD_BENCH_CGAL
-    {
+    if (cgal) {
       // CGAL's MCF on four frames' membrane meshes, beside the point-cloud method.
       const pc::FrameSet all = pc::read_frames(data, false);
       std::ifstream in(data + "/membranes.txt");

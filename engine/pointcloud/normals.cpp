@@ -96,7 +96,7 @@ std::vector<glm::vec3> pca_normals(std::span<const glm::vec3> points, const Neig
       const float len = glm::length(nrm);
       normals[i] = len > 0.0f && std::isfinite(len) ? nrm / len : glm::vec3(0.0f, 0.0f, 1.0f);
     }
-  }, 1024);
+  }, 4096);  // about 0.4 us a point: smaller clouds (the worm) run on one thread, cheaper than a spawn under load
   return normals;
 }
 

@@ -5,6 +5,7 @@
 #include "sdfkit/pointcloud/pointcloud.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/parallel.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -16,6 +17,8 @@
 #include <queue>
 #include <random>
 #include <tuple>
+
+#include <time.h>
 
 namespace sdfkit::pointcloud {
 namespace {
@@ -33,17 +36,33 @@ struct Dsu {
   }
 };
 
-// Symmetric edge list (i < j) of the neighbour graph, without duplicates.
+// Symmetric edge list (i < j) of the neighbour graph, without duplicates, in O(n k^2): the edge
+// {i, j} comes from row min(i, j) when that row lists the other, else from the other row.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> graph_edges(const Neighbours& nb, std::size_t n) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
   edges.reserve(n * static_cast<std::size_t>(nb.k));
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::uint32_t j : nb.of(i))
-      if (j != i) edges.emplace_back(std::min<std::uint32_t>(static_cast<std::uint32_t>(i), j),
-                                     std::max<std::uint32_t>(static_cast<std::uint32_t>(i), j));
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto row = nb.of(i);
+    for (std::size_t m = 0; m < row.size(); ++m) {
+      const std::uint32_t j = row[m];
+      if (j == i || std::find(row.begin(), row.begin() + static_cast<std::ptrdiff_t>(m), j) != row.begin() + static_cast<std::ptrdiff_t>(m))
+        continue;  // itself, or listed twice
+      if (j > i) {
+        edges.emplace_back(static_cast<std::uint32_t>(i), j);
+      } else {
+        const auto other = nb.of(j);
+        if (std::find(other.begin(), other.end(), static_cast<std::uint32_t>(i)) == other.end())
+          edges.emplace_back(j, static_cast<std::uint32_t>(i));
+      }
+    }
+  }
   return edges;
+}
+
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
 }
 
 }  // namespace
@@ -66,6 +85,24 @@ std::vector<float> point_sdf(SdfBackend& backend, const Mesh& surface, std::span
   return finish_field(surface, SdfDomain::Vertex, std::move(raw)).values;
 }
 
+std::vector<float> median_filter(std::span<const float> sdf, const Neighbours& nb) {
+  const std::size_t n = sdf.size();
+  if (nb.k > 0 && nb.index.size() != n * static_cast<std::size_t>(nb.k))
+    throw InputError("median_filter: one neighbour row per value is needed");
+  std::vector<float> out(n);
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    std::vector<float> v;
+    for (std::size_t i = begin; i < end; ++i) {
+      v.assign(1, sdf[i]);
+      for (std::uint32_t j : nb.of(i)) v.push_back(sdf[j]);
+      const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+      std::nth_element(v.begin(), mid, v.end());
+      out[i] = *mid;
+    }
+  }, 8192);
+  return out;
+}
+
 std::vector<glm::vec3> shift_inward(std::span<const glm::vec3> points, std::span<const glm::vec3> normals,
                                     std::span<const float> sdf) {
   std::vector<glm::vec3> out(points.size());
@@ -78,7 +115,7 @@ std::vector<glm::vec3> shift_inward(std::span<const glm::vec3> points, std::span
 MergeTree::MergeTree(std::span<const glm::vec3> points, const Neighbours& connectivity, Linkage linkage)
     : n_(points.size()) {
   const auto edges = graph_edges(connectivity, n_);
-  std::vector<float> heights;
+  std::vector<float>& heights = heights_;
   if (linkage == Linkage::Single) {
     // Kruskal: single linkage merges are the minimum spanning tree's edges by length.
     std::vector<std::pair<float, std::uint32_t>> order(edges.size());
@@ -97,60 +134,109 @@ MergeTree::MergeTree(std::span<const glm::vec3> points, const Neighbours& connec
     // Average linkage in the root-mean-square sense: the mean squared distance between the
     // points of A and B is |c_A - c_B|^2 + var_A + var_B, kept exactly by each cluster's count,
     // sum and sum of squared norms. Greedy: always merge the closest adjacent pair.
-    std::vector<double> count(n_, 1.0), sumsq(n_);
-    std::vector<glm::dvec3> sum(n_);
+    //
+    // Every cluster keeps its nearest adjacent cluster (best) and the heap holds one entry per
+    // cluster (stale entries are skipped by a per-cluster stamp), so the heap stays about n
+    // entries instead of one per graph edge and update. A merge of a and b only changes the
+    // distances to the merged cluster: a neighbour whose best was a or b rescans its adjacency,
+    // any other neighbour compares its best with the merged cluster. The merge sequence is the
+    // greedy one (tested against a brute-force search).
+    std::vector<double> count(n_, 1.0), sumsq(n_), var(n_, 0.0);
+    std::vector<glm::dvec3> sum(n_), centre(n_);
     for (std::size_t i = 0; i < n_; ++i) {
-      sum[i] = glm::dvec3(points[i]);
+      centre[i] = sum[i] = glm::dvec3(points[i]);
       sumsq[i] = glm::dot(sum[i], sum[i]);
     }
-    auto dist = [&](std::uint32_t a, std::uint32_t b) {
-      const glm::dvec3 ca = sum[a] / count[a], cb = sum[b] / count[b];
-      const double va = sumsq[a] / count[a] - glm::dot(ca, ca);
-      const double vb = sumsq[b] / count[b] - glm::dot(cb, cb);
-      const glm::dvec3 d = ca - cb;
-      return static_cast<float>(std::sqrt(std::max(0.0, glm::dot(d, d) + va + vb)));
+    auto dist2 = [&](std::uint32_t a, std::uint32_t b) {
+      const glm::dvec3 d = centre[a] - centre[b];
+      return std::max(0.0, glm::dot(d, d) + (var[a] + var[b]));
     };
+    // Adjacency as CSR first (one allocation), then per-cluster lists that merges rewrite.
     std::vector<std::vector<std::uint32_t>> adj(n_);
-    for (const auto& [a, b] : edges) {
-      adj[a].push_back(b);
-      adj[b].push_back(a);
+    {
+      std::vector<std::uint32_t> deg(n_, 0);
+      for (const auto& [a, b] : edges) {
+        ++deg[a];
+        ++deg[b];
+      }
+      for (std::size_t i = 0; i < n_; ++i) adj[i].reserve(deg[i]);
+      for (const auto& [a, b] : edges) {
+        adj[a].push_back(b);
+        adj[b].push_back(a);
+      }
     }
-    std::vector<std::uint32_t> version(n_, 0);
-    Dsu dsu(n_);
+    constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> best(n_, kNone), stamp(n_, 0);
+    std::vector<double> best_d2(n_, std::numeric_limits<double>::infinity());
+    std::vector<std::uint8_t> alive(n_, 1);
     struct Item {
-      float d;
-      std::uint32_t a, b, va, vb;
-      bool operator>(const Item& o) const { return d > o.d; }
+      double d2;
+      std::uint32_t a, stamp;
+      bool operator>(const Item& o) const { return d2 > o.d2; }
     };
-    std::vector<Item> store;
-    store.reserve(edges.size() * 3);
-    std::priority_queue<Item, std::vector<Item>, std::greater<>> heap(std::greater<>{}, std::move(store));
-    for (const auto& [a, b] : edges) heap.push({dist(a, b), a, b, 0u, 0u});
+    std::vector<Item> items;
+    items.reserve(2 * n_);
+    auto rescan = [&](std::uint32_t c) {
+      best[c] = kNone;
+      best_d2[c] = std::numeric_limits<double>::infinity();
+      for (std::uint32_t x : adj[c]) {
+        const double d = dist2(c, x);
+        if (d < best_d2[c] || (d == best_d2[c] && x < best[c])) {
+          best_d2[c] = d;
+          best[c] = x;
+        }
+      }
+    };
+    for (std::uint32_t i = 0; i < n_; ++i) {
+      rescan(i);
+      if (best[i] != kNone) items.push_back({best_d2[i], i, 0u});
+    }
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> heap(std::greater<>{}, std::move(items));
     while (!heap.empty()) {
-      const auto [d, a0, b0, va, vb] = heap.top();
+      const Item top = heap.top();
       heap.pop();
-      if (dsu.p[a0] != a0 || dsu.p[b0] != b0 || version[a0] != va || version[b0] != vb) continue;
-      std::uint32_t a = a0, b = b0;
-      if (adj[a].size() < adj[b].size()) std::swap(a, b);
-      dsu.p[b] = a;
+      if (!alive[top.a] || stamp[top.a] != top.stamp) continue;
+      std::uint32_t a = top.a, b = best[top.a];
+      if (adj[a].size() < adj[b].size()) std::swap(a, b);  // keep the larger list
       merges_.emplace_back(a, b);
-      heights.push_back(d);
+      heights.push_back(static_cast<float>(std::sqrt(top.d2)));
+      alive[b] = 0;
+      ++stamp[b];
       count[a] += count[b];
       sum[a] += sum[b];
       sumsq[a] += sumsq[b];
-      ++version[a];
-      std::vector<std::uint32_t> merged;
-      merged.reserve(adj[a].size() + adj[b].size());
-      for (std::uint32_t c : adj[a]) merged.push_back(dsu.find(c));
-      for (std::uint32_t c : adj[b]) merged.push_back(dsu.find(c));
-      std::sort(merged.begin(), merged.end());
-      merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
-      merged.erase(std::remove(merged.begin(), merged.end(), a), merged.end());
-      adj[a] = std::move(merged);
+      centre[a] = sum[a] / count[a];
+      var[a] = sumsq[a] / count[a] - glm::dot(centre[a], centre[a]);
+      // b's neighbours now border a: rewrite their lists, and a's own.
+      for (std::uint32_t c : adj[b]) {
+        if (c == a) continue;
+        auto& l = adj[c];
+        const bool has_a = std::find(l.begin(), l.end(), a) != l.end();
+        auto it = std::find(l.begin(), l.end(), b);
+        if (has_a) {
+          *it = l.back();
+          l.pop_back();
+        } else {
+          *it = a;
+          adj[a].push_back(c);
+        }
+      }
+      adj[a].erase(std::remove(adj[a].begin(), adj[a].end(), b), adj[a].end());
       std::vector<std::uint32_t>().swap(adj[b]);
+      rescan(a);
+      ++stamp[a];
+      if (best[a] != kNone) heap.push({best_d2[a], a, stamp[a]});
       for (std::uint32_t c : adj[a]) {
-        const std::uint32_t x = std::min(a, c), y = std::max(a, c);
-        heap.push({dist(a, c), x, y, version[x], version[y]});
+        if (best[c] == a || best[c] == b) {
+          rescan(c);
+        } else {
+          const double d = dist2(c, a);
+          if (!(d < best_d2[c] || (d == best_d2[c] && a < best[c]))) continue;
+          best_d2[c] = d;
+          best[c] = a;
+        }
+        ++stamp[c];
+        heap.push({best_d2[c], c, stamp[c]});
       }
     }
   }
@@ -432,10 +518,13 @@ SkeletonResult point_cloud_skeleton(std::span<const glm::vec3> points, SdfBacken
   SkeletonResult r;
   using Clock = std::chrono::steady_clock;
   auto t0 = Clock::now();
+  double c0 = process_cpu_ms();
   auto lap = [&](const char* step) {
     const auto t1 = Clock::now();
-    r.times.push_back({step, std::chrono::duration<double, std::milli>(t1 - t0).count()});
+    const double c1 = process_cpu_ms();
+    r.times.push_back({step, std::chrono::duration<double, std::milli>(t1 - t0).count(), c1 - c0});
     t0 = t1;
+    c0 = c1;
   };
   std::vector<glm::vec3> subsample;
   if (options.max_points > 0 && points.size() > options.max_points) {
@@ -468,6 +557,7 @@ SkeletonResult point_cloud_skeleton(std::span<const glm::vec3> points, SdfBacken
   lap("surface");
   if (surface.triangles.empty()) throw InputError("the point cloud gave no surface triangles (all points on a line?)");
   r.sdf = point_sdf(backend, surface, r.normals, options.sdf);
+  if (options.median) r.sdf = median_filter(r.sdf, nb);
   lap("sdf");
   r.shifted = shift_inward(points, r.normals, r.sdf);
   lap("shift");

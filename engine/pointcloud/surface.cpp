@@ -174,7 +174,7 @@ Mesh tangent_plane_surface(std::span<const glm::vec3> points, std::span<const gl
       }
       for (const auto& e : delaunay_star(xy)) stars[i].push_back({static_cast<std::uint32_t>(i), ids[e[0]], ids[e[1]]});
     }
-  }, 256);
+  }, 2048);  // about 1.2 us a point: the worm (1421 points) runs on one thread
   Mesh mesh;
   mesh.positions.assign(points.begin(), points.end());
   std::size_t total = 0;

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -207,6 +208,70 @@ TEST(PointcloudClustering, MergeTreeCountsAreMonotoneAndLabelsConsistent) {
     EXPECT_FLOAT_EQ(s.polyline.nodes[i].radius, 0.5f);
   }
   EXPECT_THROW(pc::polyline_with_segments(pts, sdf, avg, nb, 0), sdfkit::InputError);
+}
+
+TEST(PointcloudSdf, MedianFilterRemovesAnIsolatedOutlierAndKeepsALinearField) {
+  std::vector<glm::vec3> pts;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) pts.push_back({0.5f * i, 0.5f * j, 0.0f});
+  const pc::Neighbours nb = pc::k_nearest(pts, 8);
+  std::vector<float> sdf(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) sdf[i] = 2.0f + 0.1f * pts[i].x;
+  const std::size_t centre = 15 * 30 + 15;
+  std::vector<float> spiked = sdf;
+  spiked[centre] = 40.0f;  // a ray bundle through a gap
+  const auto out = pc::median_filter(spiked, nb);
+  ASSERT_EQ(out.size(), sdf.size());
+  EXPECT_NEAR(out[centre], sdf[centre], 0.051f);
+  // Interior points (a symmetric 8-neighbourhood): the linear field is unchanged.
+  const auto lin = pc::median_filter(sdf, nb);
+  for (int i = 2; i < 28; ++i)
+    for (int j = 2; j < 28; ++j) EXPECT_NEAR(lin[i * 30 + j], sdf[i * 30 + j], 1e-5f);
+  EXPECT_THROW(pc::median_filter(std::vector<float>(5, 1.0f), nb), sdfkit::InputError);
+}
+
+// Average linkage by brute force: at every step the adjacent pair of clusters (over the graph)
+// with the smallest root-mean-square point distance, computed from the points themselves.
+TEST(PointcloudClustering, AverageLinkageMergesAreTheGreedySequence) {
+  std::vector<glm::vec3> pts;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 160; ++i) pts.push_back({4.0f * u(rng), u(rng), 0.5f * u(rng)});
+  const pc::Neighbours nb = pc::k_nearest(pts, 5);
+  const pc::MergeTree tree(pts, nb, pc::Linkage::Average);
+  std::vector<int> label(pts.size());
+  std::iota(label.begin(), label.end(), 0);
+  std::set<std::pair<int, int>> edges;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (std::uint32_t j : nb.of(i)) edges.insert({std::min<int>(i, j), std::max<int>(i, j)});
+  std::vector<std::vector<std::size_t>> members(pts.size());
+  auto rms = [&](int a, int b) {
+    double s = 0.0;
+    for (std::size_t i : members[a])
+      for (std::size_t j : members[b]) s += glm::dot(pts[i] - pts[j], pts[i] - pts[j]);
+    return std::sqrt(s / static_cast<double>(members[a].size() * members[b].size()));
+  };
+  const auto heights = tree.merge_heights();
+  ASSERT_EQ(heights.size(), pts.size() - 1);  // the 5-neighbour graph of this cloud is connected
+  for (std::size_t m = 0; m < heights.size(); ++m) {
+    for (auto& v : members) v.clear();
+    for (std::size_t i = 0; i < pts.size(); ++i) members[label[i]].push_back(i);
+    std::set<std::pair<int, int>> pairs;
+    for (const auto& [i, j] : edges)
+      if (label[i] != label[j]) pairs.insert({std::min(label[i], label[j]), std::max(label[i], label[j])});
+    double best = 1e30;
+    std::pair<int, int> pick{-1, -1};
+    for (const auto& p : pairs) {
+      const double d = rms(p.first, p.second);
+      if (d < best) {
+        best = d;
+        pick = p;
+      }
+    }
+    ASSERT_NEAR(heights[m], best, 1e-4 * (1.0 + best)) << "merge " << m;
+    for (int& l : label)
+      if (l == pick.second) l = pick.first;
+  }
 }
 
 TEST(PointcloudPolyline, ResampleAndDistances) {
