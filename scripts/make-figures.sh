@@ -9,7 +9,7 @@
 #   skeleton_tube.png       builtin:tube (the paper's Figure 7 model) and its skeleton
 #   skeleton_man.png        CGAL's man.off (a human)
 #   skeleton_camel.png      CGAL's camel.off (a quadruped)
-#   skeleton_elephant.png   CGAL's elephant.off (genus 3; its ears are sheets)
+#   skeleton_elephant.png   CGAL's elephant.off (genus 3: three cycles)
 #   worm_frame.png          frame 50 of the Sibernetic worm (tests/data/worm): its surface points
 #                           and the 16-segment polyline of `sdfkit pointcloud-skeleton`
 #   worm_strip.png          6 frames of the worm with their polylines side by side (Figure 15)

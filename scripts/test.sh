@@ -31,7 +31,7 @@ if [ "${SDFKIT_SKIP_SANITIZE:-0}" != "1" ]; then
   # SDFKIT_SANITIZE_ALL=1 they run here too.
   sanitize_start=$(date +%s)
   SDFKIT_BUILD_DIR=build-asan scripts/build.sh -DSDFKIT_SANITIZE=ON -DSDFKIT_BUILD_BENCH=OFF -DSDFKIT_BUILD_PYTHON=OFF
-  exclude='^(GltfValidator|Slurm|Road|Cli|BatchRun|BatchKill|UntrustedBatch|UntrustedCli|RenderCli|SkeletonCli|PointcloudCli)\.'
+  exclude='^(GltfValidator|Slurm|Road|Cli|BatchRun|BatchKill|UntrustedBatch|UntrustedCli|RenderCli|SkeletonCli|PointcloudCli|DiffuseCli)\.'
   if [ "${SDFKIT_SANITIZE_ALL:-0}" = "1" ]; then exclude='^$'; fi
   libdir=/usr/lib/x86_64-linux-gnu
   LD_PRELOAD="$(c++ -print-file-name=libasan.so):$libdir/libvulkan_lvp.so:$libdir/libVkLayer_khronos_validation.so:$libdir/libpocl.so.2" \

@@ -2,6 +2,7 @@
 #include "diffusion_bench.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/shapes.hpp"
 #include "sdfkit/diffusion/diffuse.hpp"
 #include "sdfkit/diffusion/stm.hpp"
 #include "sdfkit/post/smooth.hpp"
@@ -45,18 +46,8 @@ DiffusionMesh cylinder_mesh(int segments, int stacks, std::uint32_t size) {
   DiffusionMesh d;
   d.name = "cylinder-" + std::to_string(segments) + "x" + std::to_string(stacks + 1);
   const float r = 1.0f, h = 2.0f * std::numbers::pi_v<float>;
-  Mesh& m = d.mesh;
-  for (int j = 0; j <= stacks; ++j)
-    for (int i = 0; i < segments; ++i) {
-      const float a = 2.0f * std::numbers::pi_v<float> * static_cast<float>(i) / static_cast<float>(segments);
-      m.positions.emplace_back(r * std::cos(a), r * std::sin(a), h * static_cast<float>(j) / static_cast<float>(stacks));
-    }
-  const auto id = [segments](int i, int j) { return static_cast<std::uint32_t>(j * segments + (i % segments)); };
-  for (int j = 0; j < stacks; ++j)
-    for (int i = 0; i < segments; ++i) {
-      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
+  d.mesh = shapes::open_cylinder(r, h, segments, stacks);
+  const Mesh& m = d.mesh;
   diffusion::AtlasMapping a;
   a.size = size;
   const std::uint32_t side = size - 2 * a.gutter;

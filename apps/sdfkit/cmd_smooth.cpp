@@ -142,16 +142,28 @@ void add_smooth_command(CLI::App& app) {
       field.kept_rays.assign(field.values.size(), 0);
       field.filled.assign(field.values.size(), 0);
       if (!a->atlas_png.empty()) diffusion::write_atlas_png(d.stm.mapping, r.asset.mesh, d.values, a->atlas_png);
-      io::write_field(a->output, r.asset, field, a->write);
+      // A glTF output carries the mapping as TEXCOORD_1 (the atlas PNG is its texture). Only a
+      // fresh glTF can: a glTF input's primitives would have to be split at the chart borders.
+      io::WriteOptions write = a->write;
+      const io::Format out_format = io::format_from_path(a->output);
+      const bool gltf_out = out_format == io::Format::Gltf || out_format == io::Format::Glb;
+      const bool gltf_in = r.asset.format == io::Format::Gltf || r.asset.format == io::Format::Glb;
+      std::string texcoord_note;
+      if (gltf_out && !gltf_in && r.asset.input_triangles.size() == r.asset.mesh.face_count())
+        write.texcoord1 = diffusion::gltf_corner_uv(d.stm.mapping, r.asset.mesh);
+      else if (gltf_out)
+        texcoord_note = gltf_in ? "; no TEXCOORD_1: the input is a glTF asset"
+                                : "; no TEXCOORD_1: the input's triangles are not the welded mesh's";
+      io::write_field(a->output, r.asset, field, write);
       char scale[64];
       if (a->radius > 0.0f) std::snprintf(scale, sizeof scale, "radius %g px", static_cast<double>(a->radius));
       else std::snprintf(scale, sizeof scale, "sigma %g", static_cast<double>(a->smooth.sigma));
       if (!a->quiet)
         std::printf("%s: %zu vertex values diffused in texture space (%zu charts on a %u² atlas, %s) in %.1f ms "
-                    "(skeleton %.2f s, mapping %.2f s, diffusion %.1f ms) -> %s\n",
+                    "(skeleton %.2f s, mapping %.2f s, diffusion %.1f ms) -> %s%s%s\n",
                     a->input.c_str(), field.values.size(), d.stm.mapping.charts.size(), d.stm.mapping.size,
-                    scale,
-                    ms, d.skeleton_seconds, d.mapping_seconds, d.diffusion.timings.total, a->output.c_str());
+                    scale, ms, d.skeleton_seconds, d.mapping_seconds, d.diffusion.timings.total, a->output.c_str(),
+                    write.texcoord1.empty() ? "" : " (the mapping as TEXCOORD_1)", texcoord_note.c_str());
       return;
 #else
       throw UsageError("--texture-space needs the Vulkan engine (built with SDFKIT_WITH_VULKAN=OFF)");

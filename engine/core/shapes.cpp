@@ -147,6 +147,25 @@ Mesh capped_cylinder(float radius, float length, int segments, int stacks, int c
   return revolve(profile, segments);
 }
 
+Mesh open_cylinder(float radius, float height, int segments, int stacks) {
+  require(radius > 0 && height > 0 && segments >= 3 && stacks >= 1, "open_cylinder");
+  Mesh m;
+  m.positions.reserve(static_cast<std::size_t>(segments) * static_cast<std::size_t>(stacks + 1));
+  for (int j = 0; j <= stacks; ++j)
+    for (int i = 0; i < segments; ++i) {
+      const double a = 2.0 * kPi * i / segments;
+      m.positions.emplace_back(static_cast<float>(radius * std::cos(a)), static_cast<float>(radius * std::sin(a)),
+                               height * static_cast<float>(j) / static_cast<float>(stacks));
+    }
+  const auto id = [segments](int i, int j) { return static_cast<std::uint32_t>(j * segments + (i % segments)); };
+  for (int j = 0; j < stacks; ++j)
+    for (int i = 0; i < segments; ++i) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return m;
+}
+
 Mesh capsule(float radius, float length, int segments, int stacks) {
   require(radius > 0 && length >= 0 && segments >= 3 && stacks >= 1, "capsule");
   std::vector<glm::vec2> profile;

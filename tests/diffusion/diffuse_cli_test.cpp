@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 namespace sdfkit::test {
 namespace {
@@ -62,6 +63,30 @@ TEST(DiffuseCli, SmoothTextureSpaceWritesTheResultAndTheAtlas) {
   char sig[8] = {};
   f.read(sig, 8);
   EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+}
+
+// A glTF output carries the mapping as TEXCOORD_1 (and TEXCOORD_0, which glTF requires before it);
+// a PLY output cannot and has none.
+TEST(DiffuseCli, GltfOutputCarriesTheMappingAsTexcoord1) {
+  ScratchDir dir;
+  const std::string sdf = dir.path("capsule.ply");
+  CommandResult r = run_command(kCli + " compute builtin:capsule -o " + sdf + " -q", dir.dir());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string glb = dir.path("smoothed.glb");
+  r = run_command(kCli + " smooth " + sdf + " -o " + glb + " --texture-space --radius 4 --atlas-size 512", dir.dir());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("TEXCOORD_1"), std::string::npos) << r.out;
+  const auto contains = [](const std::string& path, const std::string& what) {
+    std::ifstream f(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    return bytes.find(what) != std::string::npos;
+  };
+  EXPECT_TRUE(contains(glb, "\"TEXCOORD_1\""));
+  EXPECT_TRUE(contains(glb, "\"TEXCOORD_0\""));
+  const std::string ply = dir.path("smoothed.ply");
+  r = run_command(kCli + " smooth " + sdf + " -o " + ply + " --texture-space --radius 4 --atlas-size 512", dir.dir());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("TEXCOORD_1"), std::string::npos) << r.out;
 }
 
 }  // namespace

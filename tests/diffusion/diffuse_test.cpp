@@ -20,19 +20,13 @@
 namespace sdfkit::diffusion {
 namespace {
 
-class Diffuse : public ::testing::Test {
+class Diffuse : public test::DeviceTest {
 protected:
   void SetUp() override {
-    ctx_ = test::make_test_context();
-    if (!ctx_) GTEST_SKIP() << "no Vulkan device";
+    DeviceTest::SetUp();
+    if (IsSkipped()) return;
     diffuser_ = std::make_unique<Diffuser>(*ctx_);
   }
-  void TearDown() override {
-    if (ctx_) {
-      SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(*ctx_);
-    }
-  }
-  std::unique_ptr<vk::Context> ctx_;
   std::unique_ptr<Diffuser> diffuser_;
 };
 
@@ -213,6 +207,25 @@ Agreement agreement(std::span<const float> a, std::span<const float> heat) {
   return r;
 }
 
+// Texture-space diffusion of u and k-ring smoothing at the same sigma, each against heat diffusion.
+struct HeatComparison {
+  std::vector<float> texture_values;
+  Agreement texture, kring;
+  int rings = 0;
+};
+HeatComparison compare_with_heat(Diffuser& diffuser, const Mesh& m, const AtlasMapping& a, const std::vector<float>& u,
+                                 float sigma, float edge) {
+  const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
+  HeatComparison c;
+  c.texture_values = diffuser.run(m, a, u, sigma_of(sigma)).values;
+  SmoothOptions so;
+  so.sigma = sigma;
+  so.rings = c.rings = kring_for_sigma(sigma, edge);
+  c.texture = agreement(c.texture_values, heat);
+  c.kring = agreement(smooth_field(m, SdfDomain::Vertex, u, so), heat);
+  return c;
+}
+
 // Against intrinsic heat diffusion (t = sigma² / 2) on an isometrically mapped cylinder, sigma 1
 // to 5 mean edge lengths: Pearson >= 0.95, median relative difference <= 5 %, and no further from
 // heat diffusion (RMS) than k-ring smoothing at the same sigma.
@@ -225,18 +238,13 @@ TEST_F(Diffuse, MatchesHeatDiffusionOnACylinder) {
   const float edge = mean_edge_length(m);
   for (float edges : {1.0f, 2.0f, 3.0f, 5.0f}) {
     const float sigma = edges * edge;
-    const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
-    const std::vector<float> tex = diffuser_->run(m, a, u, sigma_of(sigma)).values;
-    SmoothOptions so;
-    so.sigma = sigma;
-    so.rings = kring_for_sigma(sigma, edge);
-    const std::vector<float> kring = smooth_field(m, SdfDomain::Vertex, u, so);
-    const Agreement t = agreement(tex, heat), k = agreement(kring, heat);
+    const HeatComparison c = compare_with_heat(*diffuser_, m, a, u, sigma, edge);
+    const Agreement &t = c.texture, &k = c.kring;
     EXPECT_GE(t.pearson, 0.95) << edges << " edges";
     EXPECT_LE(t.median_rel, 0.05) << edges << " edges";
     EXPECT_LE(t.rms, k.rms * 1.0 + 1e-6) << edges << " edges: texture " << t.rms << ", k-ring " << k.rms;
     std::printf("sigma %.0f edges: texture pearson %.4f median %.4f rms %.4f | k-ring (k=%d) pearson %.4f median %.4f rms %.4f\n",
-                edges, t.pearson, t.median_rel, t.rms, so.rings, k.pearson, k.median_rel, k.rms);
+                edges, t.pearson, t.median_rel, t.rms, c.rings, k.pearson, k.median_rel, k.rms);
     RecordProperty("pearson_" + std::to_string(static_cast<int>(edges)), std::to_string(t.pearson));
   }
 }
@@ -292,20 +300,16 @@ TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
   const float edge = mean_edge_length(m);
   for (float edges : {1.0f, 2.0f, 3.0f, 5.0f}) {
     const float sigma = edges * edge;
-    const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
-    const std::vector<float> tex = diffuser_->run(m, a, u, sigma_of(sigma)).values;
-    SmoothOptions so;
-    so.sigma = sigma;
-    so.rings = kring_for_sigma(sigma, edge);
-    const std::vector<float> kring = smooth_field(m, SdfDomain::Vertex, u, so);
-    const Agreement t = agreement(tex, heat), k = agreement(kring, heat);
+    const HeatComparison c = compare_with_heat(*diffuser_, m, a, u, sigma, edge);
+    const Agreement &t = c.texture, &k = c.kring;
+    const std::vector<float>& tex = c.texture_values;
     const test::SeamJumps s = test::seam_jumps(m, a, tex);
     const double ratio = test::quantile(s.border, 0.95) / test::quantile(s.inside, 0.95);
     EXPECT_GE(t.pearson, 0.95) << edges << " edges";
     EXPECT_LE(t.median_rel, 0.05) << edges << " edges";
     std::printf("camel sigma %.0f edges (%zu charts): texture pearson %.4f median %.4f rms %.4f seam ratio %.2f | "
                 "k-ring (k=%d) pearson %.4f median %.4f rms %.4f\n",
-                edges, a.charts.size(), t.pearson, t.median_rel, t.rms, ratio, so.rings, k.pearson, k.median_rel, k.rms);
+                edges, a.charts.size(), t.pearson, t.median_rel, t.rms, ratio, c.rings, k.pearson, k.median_rel, k.rms);
   }
 }
 

@@ -5,6 +5,7 @@
 // per side), and the seam statistic.
 
 #include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/shapes.hpp"
 #include "sdfkit/diffusion/atlas.hpp"
 
 #include <Eigen/Sparse>
@@ -64,23 +65,9 @@ inline std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float
   return out;
 }
 
-// An open cylinder of radius r and height h around z: `segments` columns around (vertex
-// (i, j) = j * segments + i at angle 2 pi i / segments, height j * h / stacks).
-inline Mesh open_cylinder(float r, float h, int segments, int stacks) {
-  Mesh m;
-  for (int j = 0; j <= stacks; ++j)
-    for (int i = 0; i < segments; ++i) {
-      const float a = 2.0f * std::numbers::pi_v<float> * static_cast<float>(i) / static_cast<float>(segments);
-      m.positions.emplace_back(r * std::cos(a), r * std::sin(a), h * static_cast<float>(j) / static_cast<float>(stacks));
-    }
-  const auto id = [segments](int i, int j) { return static_cast<std::uint32_t>(j * segments + (i % segments)); };
-  for (int j = 0; j < stacks; ++j)
-    for (int i = 0; i < segments; ++i) {
-      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return m;
-}
+// An open cylinder of radius r and height h around z (shapes::open_cylinder: vertex (i, j) =
+// j * segments + i at angle 2 pi i / segments, height j * h / stacks).
+inline Mesh open_cylinder(float r, float h, int segments, int stacks) { return shapes::open_cylinder(r, h, segments, stacks); }
 
 struct CylinderGrid {
   float r = 1.0f, h = 4.0f;

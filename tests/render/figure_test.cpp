@@ -24,19 +24,7 @@ std::size_t covered(const Image& img) {
   return n;
 }
 
-class Render : public ::testing::Test {
-protected:
-  void SetUp() override {
-    ctx_ = test::make_test_context();
-    if (!ctx_) GTEST_SKIP() << "no Vulkan device";
-  }
-  void TearDown() override {
-    if (ctx_) {
-      SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(*ctx_);
-    }
-  }
-  std::unique_ptr<vk::Context> ctx_;
-};
+using Render = test::DeviceTest;
 
 // One orthographic view of a sphere of radius R covers pi (R * pixels_per_unit)^2 pixels.
 TEST_F(Render, SphereCoversItsProjectedDisc) {

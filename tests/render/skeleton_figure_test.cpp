@@ -128,19 +128,7 @@ TEST(SkeletonFile, MeshSkeletonsPolylinesAndFrames) {
 
 // ---- On the device -----------------------------------------------------------------------------
 
-class SkeletonPicture : public ::testing::Test {
-protected:
-  void SetUp() override {
-    ctx_ = test::make_test_context();
-    if (!ctx_) GTEST_SKIP() << "no Vulkan device";
-  }
-  void TearDown() override {
-    if (ctx_) {
-      SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(*ctx_);
-    }
-  }
-  std::unique_ptr<vk::Context> ctx_;
-};
+using SkeletonPicture = test::DeviceTest;
 
 // Boxes 1 x 1.5 x 5 along each axis, drawn by the longest-axis rule in 4 views: the box stands
 // in every view (its pixel box is taller than wide) and fills at least 90 % of each view's

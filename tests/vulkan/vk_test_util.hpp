@@ -42,4 +42,20 @@ inline std::string joined(const std::vector<std::string>& messages) {
 #define SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(ctx) \
   EXPECT_EQ((ctx).validation_message_count(), 0u) << ::sdfkit::test::joined((ctx).validation_messages())
 
+// A fixture with a validated context `ctx_` (the test is skipped when no device exists and
+// SDFKIT_ALLOW_NO_DEVICE=1) that fails a test which left validation messages behind.
+class DeviceTest : public ::testing::Test {
+protected:
+  void SetUp() override {
+    ctx_ = make_test_context();
+    if (!ctx_) GTEST_SKIP() << "no Vulkan device";
+  }
+  void TearDown() override {
+    if (ctx_) {
+      SDFKIT_EXPECT_NO_VALIDATION_MESSAGES(*ctx_);
+    }
+  }
+  std::unique_ptr<vk::Context> ctx_;
+};
+
 }  // namespace sdfkit::test

@@ -23,6 +23,12 @@ Mesh torus(float major, float minor, int major_segments, int minor_segments);
 // Axis-aligned box centred at the origin with sizes (sx, sy, sz), each face an n x n grid.
 Mesh box(float sx, float sy, float sz, int n);
 
+// Not closed: the open side of a cylinder of `radius` around z, from z = 0 to `height`, as a
+// regular grid (texture-space tests and benchmarks map it analytically): vertex (i, j) is
+// j * segments + i, at angle 2 pi i / segments and height j * height / stacks. segments >= 3,
+// stacks >= 1.
+Mesh open_cylinder(float radius, float height, int segments, int stacks);
+
 // The paper's Figure 7 model: a circle swept along a planar cubic Bezier curve, its diameter
 // growing linearly with arc length from `d0` to `d1` (2 to 20 in the paper), flat caps.
 struct SweptTube {
