@@ -213,7 +213,12 @@ FrameSet read_sibernetic(const fs::path& dir, bool surface_only) {
 
 std::vector<glm::vec3> read_point_cloud(const std::string& path) {
   if (!fs::is_regular_file(path)) throw InputError("cannot open " + path + " (not a file)");
-  std::vector<glm::vec3> pts = lower_ext(path) == ".ply" ? read_ply(path) : read_text(path);
+  // Mesh formats other than PLY are not point clouds: read as text, an OFF header's counts or an OBJ's
+  // face lines would pass for points.
+  const std::string ext = lower_ext(path);
+  if (ext == ".off" || ext == ".obj" || ext == ".stl" || ext == ".gltf" || ext == ".glb")
+    throw InputError(path + ": a mesh file, not a point cloud (point clouds are .ply, .xyz, .csv, .txt or .pts)");
+  std::vector<glm::vec3> pts = ext == ".ply" ? read_ply(path) : read_text(path);
   if (pts.empty()) throw InputError(path + ": no points");
   for (const glm::vec3& p : pts)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))

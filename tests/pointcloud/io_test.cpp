@@ -57,6 +57,9 @@ TEST(PointcloudIo, TextFormatsAndErrors) {
   EXPECT_THROW(pc::read_point_cloud(d.write("f.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n")),
                sdfkit::InputError);
   EXPECT_THROW(pc::read_point_cloud(d.path("missing.xyz")), sdfkit::InputError);
+  // A mesh file is refused by name, not read as text (an OFF's "OFF" line and counts looked like a point).
+  for (const char* name : {"m.off", "m.OBJ", "m.glb"})
+    EXPECT_THROW(pc::read_point_cloud(d.write(name, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")), sdfkit::InputError) << name;
 }
 
 TEST(PointcloudIo, DirectoriesAndGlobsInNameOrder) {
