@@ -78,14 +78,29 @@ void expand_one(const std::string& input, std::set<std::string>& out, std::set<s
   expand_path(input, is_manifest(input), out, manifests, 0);
 }
 
-// A result is complete when its record says ok with the same fingerprint and the output exists.
+// The output file as it is now (size and modification time); empty when there is none. The record
+// keeps the stamp of the output it was written for, so an output replaced after its record (a run
+// with other options killed between its output's rename and its record's) is not taken for that
+// record's result.
+std::string output_stamp(const std::string& output) {
+  std::error_code ec;
+  const auto size = fs::file_size(output, ec);
+  if (ec) return {};
+  const auto mtime = fs::last_write_time(output, ec).time_since_epoch().count();
+  if (ec) return {};
+  return " output=" + std::to_string(size) + "/" + std::to_string(mtime);
+}
+
+// A result is complete when its record says ok with the same fingerprint, written for the output
+// that exists now.
 bool complete(const std::string& output, const std::string& record, const std::string& print) {
   std::error_code ec;
-  if (!fs::exists(output, ec) || !fs::exists(record, ec)) return false;
+  const std::string stamp = output_stamp(output);
+  if (stamp.empty() || !fs::exists(record, ec)) return false;
   try {
     std::ifstream f(record);
     const auto j = nlohmann::json::parse(f);
-    return j.value("ok", false) && j.value("fingerprint", std::string()) == print;
+    return j.value("ok", false) && j.value("fingerprint", std::string()) == print + stamp;
   } catch (const std::exception&) {
     return false;
   }
@@ -290,7 +305,7 @@ BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOption
         if (!a.error.empty()) a.status = AssetStatus::Failed;
         const auto t1 = clock::now();
         try {
-          const std::string text = report_to_json(report, a.error, a.error.empty() ? print : std::string());
+          const std::string text = report_to_json(report, a.error, a.error.empty() ? print + output_stamp(a.output) : std::string());
           io::write_file_atomically(a.record, [&](std::ostream& os) { os << text << '\n'; });
         } catch (const std::exception& e) {
           if (a.error.empty()) {

@@ -8,7 +8,9 @@
 
 #include <sys/wait.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -94,6 +96,24 @@ TEST_F(BatchRun, RerunSkipsCompleteResultsAndResumesTheRest) {
   EXPECT_EQ(statuses().at("cube-ouvert.off"), "done");
   batch("--force", 7);
   EXPECT_EQ(statuses().at("cow.off"), "done");
+}
+
+// A run with other options killed after its output's rename and before its record's leaves a new
+// output beside the old record: a rerun with the old options must not take it for its result.
+TEST_F(BatchRun, AnOutputReplacedAfterItsRecordIsRecomputed) {
+  batch("");
+  ASSERT_EQ(statuses().at("cow.off"), "done");
+  const fs::path out = dir_ / "out" / "cow.txt";
+  const auto stamp = fs::last_write_time(out);
+  std::ofstream(out, std::ios::app) << "# written by another run\n";
+  fs::last_write_time(out, stamp + std::chrono::seconds(1));
+  batch("");
+  const auto s = statuses();
+  EXPECT_EQ(s.at("cow.off"), "done");
+  EXPECT_EQ(s.at("elephant.off"), "skipped");
+  std::ifstream f(out);
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("another run"), std::string::npos);
 }
 
 TEST_F(BatchRun, TemporariesOfAKilledRunAreRemovedOnResume) {
