@@ -131,15 +131,26 @@ double share_differing(const std::vector<float>& a, const std::vector<float>& b,
   return static_cast<double>(n) / static_cast<double>(std::max<std::size_t>(a.size(), 1));
 }
 
+// The scene of write_scene in a scratch directory, its request (16 rays) and the loaded asset.
+struct SceneJob {
+  test::ScratchDir scratch;
+  std::string input = write_scene(scratch.dir());
+  ComputeRequest request = [this] {
+    ComputeRequest r;
+    r.input = input;
+    r.sdf.rays = 16;
+    return r;
+  }();
+  io::Asset asset = load_input(input, request.load);
+};
+
 }  // namespace
 
 TEST(GltfInstancing, OneComputationPerMeshAndSimilarityClassEqualToPerInstance) {
-  test::ScratchDir scratch;
-  const std::string in = write_scene(scratch.dir());
-  ComputeRequest request;
-  request.input = in;
-  request.sdf.rays = 16;
-  const io::Asset asset = load_input(in, request.load);
+  const SceneJob job;
+  const test::ScratchDir& scratch = job.scratch;
+  const ComputeRequest& request = job.request;
+  const io::Asset& asset = job.asset;
   const io::SolidPlan plan = io::plan_solids(asset);
   ASSERT_EQ(plan.solids.size(), 7u);
   EXPECT_EQ(plan.solids[5].vertex_ranges.size(), 240u);  // hundreds of primitives, one solid
@@ -211,12 +222,10 @@ TEST(GltfInstancing, OneComputationPerMeshAndSimilarityClassEqualToPerInstance) 
 // The written-back scene (per-instance copies of meshes) is valid glTF for the Khronos validator.
 // In the GltfValidator suite: it spawns node, so the sanitizer stage leaves it to the normal one.
 TEST(GltfValidator, InstancedSceneWrittenBackIsClean) {
-  test::ScratchDir scratch;
-  const std::string in = write_scene(scratch.dir());
-  ComputeRequest request;
-  request.input = in;
-  request.sdf.rays = 16;
-  const io::Asset asset = load_input(in, request.load);
+  const SceneJob job;
+  const test::ScratchDir& scratch = job.scratch;
+  const ComputeRequest& request = job.request;
+  const io::Asset& asset = job.asset;
   Session session(std::make_unique<CountingBackend>());
   ComputeResult r = compute_asset(request, asset, [&]() -> Session& { return session; });
   const std::string out = (scratch.dir() / "scene-sdf.glb").string();
