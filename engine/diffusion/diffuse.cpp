@@ -100,7 +100,7 @@ std::array<std::uint32_t, 3> box_radii(float sigma_px) {
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge) {
   check_options(options);
   BlurPlan plan;
-  plan.dispatches = passes::kBlurDispatches;
+  plan.fused = options.fused_blur;
   for (const Chart& c : mapping.charts) {
     auto r = box_radii(sigma_px_of(c, options, mean_edge));
     // A periodic box no wider than the period (the shader wraps an index once at most).
@@ -108,10 +108,31 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, f
       for (std::uint32_t& x : r) x = std::min(x, c.width > 1 ? (c.width - 1) / 2 : 0u);
     plan.radii.push_back(r);
     plan.line_jobs += std::uint64_t{c.width} + c.height;
+    // The fused shader clips a plain line's radii to its length - 1 (a wider box sums the whole
+    // line wherever it is centred on it); its rings hold every box's window.
+    const auto clip = [](std::uint32_t x, std::uint32_t n) { return std::min(x, n - 1); };
     for (std::uint32_t box = 0; box < 3; ++box) {
-      const std::uint64_t window = 2ull * r[box] + 1;
-      plan.texel_reads += std::uint64_t{c.height} * (2ull * c.width + window);  // rows
-      plan.texel_reads += std::uint64_t{c.width} * (2ull * c.height + window);  // columns
+      const std::uint32_t row = c.wraps_x ? r[box] : clip(r[box], c.width), column = clip(r[box], c.height);
+      if (std::max(row, column) > passes::kFusedMaxRadius) plan.fused = false;
+    }
+  }
+  plan.dispatches = plan.fused ? passes::kFusedBlurDispatches : passes::kBoxBlurDispatches;
+  for (std::size_t i = 0; i < mapping.charts.size(); ++i) {
+    const Chart& c = mapping.charts[i];
+    const auto& r = plan.radii[i];
+    const std::uint64_t w = c.width, h = c.height;
+    if (plan.fused) {
+      // One walk per line reading every texel once (what leaves box 0's window comes from a
+      // ring); a wrapping row walks r0 + r1 + r2 texels past either end (a plain line reads
+      // nothing outside itself).
+      const std::uint64_t extra = c.wraps_x ? 2ull * (r[0] + r[1] + r[2]) : 0ull;
+      plan.texel_reads += h * (w + extra) + w * h;
+    } else {
+      for (std::uint32_t box = 0; box < 3; ++box) {
+        const std::uint64_t window = 2ull * r[box] + 1;
+        plan.texel_reads += h * (2 * w + window);  // rows
+        plan.texel_reads += w * (2 * h + window);  // columns
+      }
     }
   }
   return plan;
@@ -170,11 +191,12 @@ struct Diffuser::Impl {
       : ctx(c),
         raster(make_raster_pipeline(c)),
         blur(make_compute(c, "atlas_blur.comp", 4, sizeof(passes::BlurPush))),
+        blur_box(make_compute(c, "atlas_blur_box.comp", 4, sizeof(passes::BlurPush))),
         sample(make_compute(c, "atlas_sample.comp", 4, sizeof(passes::SamplePush))),
         dilate(make_compute(c, "atlas_dilate.comp", 3, sizeof(passes::DilatePush))),
         transients(c) {}
   vk::Context& ctx;
-  vk::Pipeline raster, blur, sample, dilate;
+  vk::Pipeline raster, blur, blur_box, sample, dilate;
   vk::TransientPool transients;
 };
 
@@ -291,6 +313,8 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
 
   passes::AtlasBlurPass bp;
   bp.pipeline = &impl_->blur;
+  bp.box_pipeline = &impl_->blur_box;
+  bp.fused = result.plan.fused;
   bp.texels = rastered;
   bp.scratch = scratch;
   bp.charts = chart_h;

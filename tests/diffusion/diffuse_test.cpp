@@ -59,22 +59,30 @@ TEST(DiffusePlan, BoxCascadeHasTheGaussiansVariance) {
   EXPECT_EQ(box_radii(0.0f), (std::array<std::uint32_t, 3>{0, 0, 0}));
 }
 
-// The blur's work (reads per pass, dispatches) on a 2048² atlas: radius 64 costs what radius 2
-// costs (the running sums read each texel twice whatever the radius; only the window's warm-up
-// grows).
+// The blur's work (reads, dispatches) on a 2048² atlas: radius 64 costs what radius 2 costs (the
+// running sums read each texel twice whatever the radius; only the windows' warm-up grows), both
+// in the fused two-dispatch form; radii beyond its rings take the six-dispatch cascade.
 TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   AtlasMapping a;
   a.size = 2048;
   a.charts.push_back({Chart::Kind::Bone, 2, 2, 2044, 2044, true, 10.0f});
-  DiffuseOptions r2, r64;
+  DiffuseOptions r2, r64, r200;
   r2.radius_px = 2.0f;
   r64.radius_px = 64.0f;
-  const BlurPlan p2 = plan_blur(a, r2), p64 = plan_blur(a, r64);
-  EXPECT_EQ(p2.dispatches, 6u);
+  r200.radius_px = 200.0f;
+  const BlurPlan p2 = plan_blur(a, r2), p64 = plan_blur(a, r64), p200 = plan_blur(a, r200);
+  EXPECT_TRUE(p2.fused);
+  EXPECT_EQ(p2.dispatches, 2u);
   EXPECT_EQ(p64.dispatches, p2.dispatches);
   EXPECT_EQ(p64.line_jobs, p2.line_jobs);
   EXPECT_LE(static_cast<double>(p64.texel_reads), 1.1 * static_cast<double>(p2.texel_reads));
   EXPECT_GE(p64.radii[0][0], 30u);
+  EXPECT_FALSE(p200.fused);
+  EXPECT_EQ(p200.dispatches, 6u);
+  // A plain (not wrapping) chart shorter than the boxes: the fused shader clips them to the line.
+  AtlasMapping small = a;
+  small.charts[0] = {Chart::Kind::Sheet, 2, 2, 100, 80, false, 10.0f};
+  EXPECT_TRUE(plan_blur(small, r200).fused);
 }
 
 TEST(DiffusePlan, KRingForSigmaPutsTheLastRingNearTwoSigma) {
@@ -192,6 +200,53 @@ TEST_F(Diffuse, CylindricalChartsWrap) {
     EXPECT_NEAR(at(seam, -d), at(seam, d), 1e-3f * at(seam, d)) << d;     // symmetric across the seam
     EXPECT_NEAR(at(seam, -d), at(middle, 32 - d), 1e-3f * at(seam, d)) << d;  // as in the middle
     EXPECT_GT(at(seam, -d), 1.05f);
+  }
+}
+
+// The fused blur (three boxes per axis in one dispatch, rings in private memory) gives the
+// six-dispatch cascade's values to float rounding: wrapping and plain charts, radii from one
+// texel to boxes wider than the charts (clipped to the line), vertices and the dilated atlas.
+TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const std::vector<float> u = test_field(m);
+  test::CylinderGrid coarse = g;  // charts of 49 x 83 texels: radius 100 is clipped to them
+  coarse.texels_per_column = 2;
+  struct Case {
+    AtlasMapping a;
+    float radius;
+  };
+  const std::vector<Case> cases = {{test::cylinder_wrapping_mapping(m, g, 512), 1.0f},
+                                   {test::cylinder_wrapping_mapping(m, g, 512), 8.0f},
+                                   {test::cylinder_wrapping_mapping(m, g, 512), 40.0f},
+                                   {test::cylinder_split_mapping(m, g, 1024, 4, 4), 3.0f},
+                                   {test::cylinder_split_mapping(m, g, 1024, 4, 4), 64.0f},
+                                   {test::cylinder_split_mapping(m, coarse, 256, 4, 4), 100.0f}};
+  for (const Case& c : cases) {
+    DiffuseOptions fused;
+    fused.radius_px = c.radius;
+    fused.keep_atlas = true;
+    DiffuseOptions box = fused;
+    box.fused_blur = false;
+    const DiffuseResult f = diffuser_->run(m, c.a, u, fused), b = diffuser_->run(m, c.a, u, box);
+    ASSERT_TRUE(f.plan.fused) << c.radius;
+    ASSERT_FALSE(b.plan.fused);
+    EXPECT_EQ(f.plan.dispatches, 2u);
+    EXPECT_EQ(b.plan.dispatches, 6u);
+    float worst = 0.0f, spread = 0.0f;
+    for (std::size_t v = 0; v < u.size(); ++v) {
+      worst = std::max(worst, std::abs(f.values[v] - b.values[v]));
+      spread = std::max(spread, std::abs(f.values[v] - f.values[0]));
+    }
+    EXPECT_LE(worst, 2e-5f) << "radius " << c.radius << " (" << c.a.charts.size() << " charts)";
+    EXPECT_GT(spread, 1e-3f) << "radius " << c.radius;  // a field that still varies
+    ASSERT_EQ(f.atlas.size(), b.atlas.size());
+    for (std::size_t i = 0; i < f.atlas.size(); ++i) {
+      ASSERT_EQ(std::isnan(f.atlas[i]), std::isnan(b.atlas[i])) << i;
+      if (!std::isnan(f.atlas[i])) {
+        ASSERT_NEAR(f.atlas[i], b.atlas[i], 2e-5f) << "radius " << c.radius << " texel " << i;
+      }
+    }
   }
 }
 
