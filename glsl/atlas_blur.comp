@@ -10,8 +10,8 @@
 // past it), rows of a wrapping chart wrap instead, so nothing enters from another chart or the
 // gutter. Both channels (value · coverage, coverage) are blurred (normalized convolution). The
 // sums are the cascade's term for term on plain lines; wrapping rows start their walk r1 + r2
-// texels early, and boxes wider than a plain line are clipped to it, so those agree to float
-// rounding.
+// texels early, so those agree to float rounding. plan_blur sends a line here only when its
+// radii fit the rings and the walk's overrun past the line is small against it.
 #extension GL_GOOGLE_include_directive : require
 #include "atlas_common.glsl"
 
@@ -73,15 +73,8 @@ void main() {
     g_n = int(c.rect.w);
     g_wrap = false;
   }
-  int r0 = int(c.params.x), r1 = int(c.params.y), r2 = int(c.params.z);
+  const int r0 = int(c.params.x), r1 = int(c.params.y), r2 = int(c.params.z);
   const float norm0 = 1.0 / float(2 * r0 + 1), norm1 = 1.0 / float(2 * r1 + 1), norm2 = 1.0 / float(2 * r2 + 1);
-  if (!g_wrap) {
-    // A box wider than the line sums the whole line wherever it is centred on it: the same sums
-    // with shorter walks and rings.
-    r0 = min(r0, g_n - 1);
-    r1 = min(r1, g_n - 1);
-    r2 = min(r2, g_n - 1);
-  }
   g_period_shift = g_n * ((r0 + r1 + r2 + 1) / g_n + 1);
   const int w1 = 2 * r1 + 1, w2 = 2 * r2 + 1;
   // t: the position of box 0's output; box 1's is p = t - r1, box 2's q = p - r2. A wrapping row

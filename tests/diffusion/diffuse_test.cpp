@@ -60,8 +60,9 @@ TEST(DiffusePlan, BoxCascadeHasTheGaussiansVariance) {
 }
 
 // The blur's work (reads, dispatches) on a 2048² atlas: radius 64 costs what radius 2 costs (the
-// running sums read each texel twice whatever the radius; only the windows' warm-up grows), both
-// in the fused two-dispatch form; radii beyond its rings take the six-dispatch cascade.
+// running sums read each texel once (fused) or twice per box (cascade) whatever the radius; only
+// the windows' warm-up and the fused walk's overrun grow), both fused in two dispatches. Radii
+// beyond the fused shader's rings, and lines short against their radii, take the cascade.
 TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   AtlasMapping a;
   a.size = 2048;
@@ -71,18 +72,30 @@ TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   r64.radius_px = 64.0f;
   r200.radius_px = 200.0f;
   const BlurPlan p2 = plan_blur(a, r2), p64 = plan_blur(a, r64), p200 = plan_blur(a, r200);
-  EXPECT_TRUE(p2.fused);
   EXPECT_EQ(p2.dispatches, 2u);
+  EXPECT_EQ(p2.fused_lines, 2u * 2044u);
   EXPECT_EQ(p64.dispatches, p2.dispatches);
+  EXPECT_EQ(p64.fused_lines, p2.fused_lines);
   EXPECT_EQ(p64.line_jobs, p2.line_jobs);
   EXPECT_LE(static_cast<double>(p64.texel_reads), 1.1 * static_cast<double>(p2.texel_reads));
   EXPECT_GE(p64.radii[0][0], 30u);
-  EXPECT_FALSE(p200.fused);
+  EXPECT_EQ(p200.fused_lines, 0u);
   EXPECT_EQ(p200.dispatches, 6u);
-  // A plain (not wrapping) chart shorter than the boxes: the fused shader clips them to the line.
-  AtlasMapping small = a;
-  small.charts[0] = {Chart::Kind::Sheet, 2, 2, 100, 80, false, 10.0f};
-  EXPECT_TRUE(plan_blur(small, r200).fused);
+  // A small chart beside the big one at radius 16: its lines are short against the radius, so
+  // they take the cascade while the big chart's are fused: per axis one fused and three cascade
+  // dispatches. With fused_blur off everything is the cascade.
+  AtlasMapping two = a;
+  two.charts[0].width = 2000;
+  two.charts.push_back({Chart::Kind::Sheet, 2010, 2, 20, 30, false, 10.0f});
+  DiffuseOptions r16;
+  r16.radius_px = 16.0f;
+  const BlurPlan mixed = plan_blur(two, r16);
+  EXPECT_EQ(mixed.fused[0], (std::array<bool, 2>{true, true}));
+  EXPECT_EQ(mixed.fused[1], (std::array<bool, 2>{false, false}));
+  EXPECT_EQ(mixed.dispatches, 8u);
+  r16.fused_blur = false;
+  EXPECT_EQ(plan_blur(two, r16).fused_lines, 0u);
+  EXPECT_EQ(plan_blur(two, r16).dispatches, 6u);
 }
 
 TEST(DiffusePlan, KRingForSigmaPutsTheLastRingNearTwoSigma) {
@@ -205,23 +218,38 @@ TEST_F(Diffuse, CylindricalChartsWrap) {
 
 // The fused blur (three boxes per axis in one dispatch, rings in private memory) gives the
 // six-dispatch cascade's values to float rounding: wrapping and plain charts, radii from one
-// texel to boxes wider than the charts (clipped to the line), vertices and the dilated atlas.
+// texel up, fused and cascade lines mixed in one run, vertices and the dilated atlas.
 TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
   const test::CylinderGrid g;
   const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
   const std::vector<float> u = test_field(m);
-  test::CylinderGrid coarse = g;  // charts of 49 x 83 texels: radius 100 is clipped to them
-  coarse.texels_per_column = 2;
   struct Case {
     AtlasMapping a;
     float radius;
   };
-  const std::vector<Case> cases = {{test::cylinder_wrapping_mapping(m, g, 512), 1.0f},
+  // Both mappings in one atlas: the wrapping chart, and the four split charts beside it carrying
+  // copies of the triangles (the vertices stay in the wrapping chart; the atlas shows all).
+  AtlasMapping both = test::cylinder_wrapping_mapping(m, g, 1024);
+  const AtlasMapping split = test::cylinder_split_mapping(m, g, 1024, 4, 4);
+  const auto first = static_cast<std::uint32_t>(both.charts.size());
+  for (Chart ch : split.charts) {
+    ch.x0 += 300;
+    both.charts.push_back(ch);
+  }
+  for (AtlasTriangle t : split.triangles) {
+    t.chart += first;
+    for (glm::vec2& uv : t.uv) uv.x += 300.0f;
+    both.triangles.push_back(t);
+  }
+  // Radius 40 on the wrapping chart: its rows (257 texels) take the cascade, its columns are
+  // fused, in the same run; radius 24 on both: the wrapping chart's rows take the cascade, the
+  // split charts' rows are fused, in the same axis.
+  const std::vector<Case> cases = {{both, 24.0f},
+                                   {test::cylinder_wrapping_mapping(m, g, 512), 1.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 8.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 40.0f},
                                    {test::cylinder_split_mapping(m, g, 1024, 4, 4), 3.0f},
-                                   {test::cylinder_split_mapping(m, g, 1024, 4, 4), 64.0f},
-                                   {test::cylinder_split_mapping(m, coarse, 256, 4, 4), 100.0f}};
+                                   {test::cylinder_split_mapping(m, g, 1024, 4, 4), 12.0f}};
   for (const Case& c : cases) {
     DiffuseOptions fused;
     fused.radius_px = c.radius;
@@ -229,9 +257,13 @@ TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
     DiffuseOptions box = fused;
     box.fused_blur = false;
     const DiffuseResult f = diffuser_->run(m, c.a, u, fused), b = diffuser_->run(m, c.a, u, box);
-    ASSERT_TRUE(f.plan.fused) << c.radius;
-    ASSERT_FALSE(b.plan.fused);
-    EXPECT_EQ(f.plan.dispatches, 2u);
+    EXPECT_GT(f.plan.fused_lines, 0u) << c.radius;
+    EXPECT_EQ(f.plan.cascade_lines > 0, c.radius == 40.0f || c.radius == 24.0f) << c.radius;
+    if (c.radius == 24.0f) {
+      EXPECT_EQ(f.plan.fused[0], (std::array<bool, 2>{false, true}));
+      EXPECT_EQ(f.plan.fused[1], (std::array<bool, 2>{true, true}));
+    }
+    EXPECT_EQ(b.plan.fused_lines, 0u);
     EXPECT_EQ(b.plan.dispatches, 6u);
     float worst = 0.0f, spread = 0.0f;
     for (std::size_t v = 0; v < u.size(); ++v) {

@@ -70,12 +70,15 @@ struct DiffuseTimings {
 // interpolation over triangles contributes (mean edge² / 4 per axis, see diffuse.cpp) is taken off the blur's.
 struct BlurPlan {
   std::vector<std::array<std::uint32_t, 3>> radii;  // per chart
-  // Fused: the three boxes of an axis in one dispatch (2 in all), windows through ring buffers;
-  // only when every radius fits them (passes/atlas_passes.hpp kFusedMaxRadius), else one
-  // dispatch per box (6).
-  bool fused = true;
-  std::uint32_t dispatches = 0;    // compute dispatches of the blur
-  std::uint64_t line_jobs = 0;     // rows + columns, each axis
+  // Per chart, rows then columns: walked by the fused shader (the three boxes of an axis in one
+  // walk, windows through ring buffers) rather than the cascade (one dispatch per box). Fused
+  // where the radii fit its rings (passes/atlas_passes.hpp kFusedMaxRadius) and the walk's overrun
+  // past the line (r1 + r2, a wrapping row 2 (r0 + r1 + r2)) is at most half the line, since each
+  // fused step costs about two cascade steps; never with DiffuseOptions::fused_blur off.
+  std::vector<std::array<bool, 2>> fused;
+  std::uint64_t fused_lines = 0, cascade_lines = 0;
+  std::uint32_t dispatches = 0;    // compute dispatches of the blur: per axis 1 fused + 3 cascade, when used
+  std::uint64_t line_jobs = 0;     // rows + columns
   std::uint64_t texel_reads = 0;   // texels read from storage: fused once per walk, cascade twice per box + warm-up
 };
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge = 0.0f);
