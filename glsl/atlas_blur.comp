@@ -17,7 +17,8 @@
 
 layout(local_size_x = 64) in;
 
-// Box radii are at most kRing / 2 - 1 (passes/atlas_passes.hpp kFusedMaxRadius).
+// Lines up to kRing texels run in private memory whatever the radii; longer lines stream, with
+// radii at most kRing / 2 - 1 (passes/atlas_passes.hpp kFusedMaxRadius, kShortLine).
 const int kRing = 256;
 
 layout(std430, binding = 0) readonly buffer Jobs { uvec2 jobs[]; };  // chart, line within the chart
@@ -57,6 +58,31 @@ vec2 fetch(int k) {
   return src[src_index(g_origin + uint(k) * g_step)];
 }
 
+// One box of radius R over the short line SRC[0, g_n) into DST, as the cascade's pass does it:
+// zeros outside a plain line, periodic on a wrapping row (R <= (g_n - 1) / 2 there, plan_blur).
+#define BOX(SRC, DST, R, NORM)                                                  \
+  {                                                                             \
+    vec2 s = vec2(0.0);                                                         \
+    if (g_wrap) {                                                               \
+      for (int k = -(R); k <= (R); ++k) s += SRC[k < 0 ? k + g_n : k];          \
+    } else {                                                                    \
+      for (int k = 0; k <= min(R, g_n - 1); ++k) s += SRC[k];                   \
+    }                                                                           \
+    for (int i = 0; i < g_n; ++i) {                                             \
+      DST[i] = s * (NORM);                                                      \
+      int a = i + (R) + 1, b = i - (R);                                         \
+      vec2 add = vec2(0.0), sub = vec2(0.0);                                    \
+      if (g_wrap) {                                                             \
+        add = SRC[a >= g_n ? a - g_n : a];                                      \
+        sub = SRC[b < 0 ? b + g_n : b];                                         \
+      } else {                                                                  \
+        if (a < g_n) add = SRC[a];                                              \
+        if (b >= 0) sub = SRC[b];                                               \
+      }                                                                         \
+      s += add - sub;                                                           \
+    }                                                                           \
+  }
+
 void main() {
   const uint j = gl_GlobalInvocationID.x;
   if (j >= pc.job_count) return;
@@ -76,6 +102,19 @@ void main() {
   const int r0 = int(c.params.x), r1 = int(c.params.y), r2 = int(c.params.z);
   const float norm0 = 1.0 / float(2 * r0 + 1), norm1 = 1.0 / float(2 * r1 + 1), norm2 = 1.0 / float(2 * r2 + 1);
   g_period_shift = g_n * ((r0 + r1 + r2 + 1) / g_n + 1);
+  if (g_n <= kRing) {
+    // A short line: read it once into ring0, run the three boxes in private memory (ring0 ->
+    // ring1 -> ring2 -> ring0), write it once. No walk past the line, whatever the radii.
+    for (int k = 0; k < g_n; ++k) ring0[k] = src[src_index(g_origin + uint(k) * g_step)];
+    BOX(ring0, ring1, r0, norm0);
+    BOX(ring1, ring2, r1, norm1);
+    BOX(ring2, ring0, r2, norm2);
+    for (int k = 0; k < g_n; ++k) {
+      const uvec2 o = g_origin + uint(k) * g_step;
+      dst[tiled_index(o.x, o.y, pc.size)] = ring0[k];
+    }
+    return;
+  }
   const int w1 = 2 * r1 + 1, w2 = 2 * r2 + 1;
   // t: the position of box 0's output; box 1's is p = t - r1, box 2's q = p - r2. A wrapping row
   // starts r1 + r2 early so that boxes 1 and 2 see the periodic continuation; a plain line starts

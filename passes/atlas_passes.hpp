@@ -87,6 +87,8 @@ vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPa
 // The largest box radius the fused shader's rings hold (glsl/atlas_blur.comp kRing = 256 >=
 // 2 · 127 + 1).
 inline constexpr std::uint32_t kFusedMaxRadius = 127;
+// Lines up to this many texels the fused shader runs whole in private memory, at any radius.
+inline constexpr std::uint32_t kShortLine = 256;
 
 // Per vertex: the normalized bilinear read of the blurred texels. Returns the written `values`.
 struct AtlasSamplePass {

@@ -114,12 +114,14 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, f
       const bool wrap = axis == 0 && c.wraps_x;
       const std::uint64_t e[3] = {r[0], r[1], r[2]};
       const std::uint64_t overrun = wrap ? 2 * (e[0] + e[1] + e[2]) : e[1] + e[2];
-      fused[static_cast<std::size_t>(axis)] = options.fused_blur && std::max({e[0], e[1], e[2]}) <= passes::kFusedMaxRadius &&
-                                              2 * overrun <= n;
+      // A short line runs whole in private memory (any radius); a longer one streams.
+      const bool whole = n <= passes::kShortLine;
+      fused[static_cast<std::size_t>(axis)] =
+          options.fused_blur && (whole || (std::max({e[0], e[1], e[2]}) <= passes::kFusedMaxRadius && 2 * overrun <= n));
       if (fused[static_cast<std::size_t>(axis)]) {
-        // One walk per line reading every texel once (what leaves box 0's window comes from a
-        // ring); a wrapping row also reads its overrun (a plain line reads nothing outside itself).
-        plan.texel_reads += lines * (n + (wrap ? overrun : 0));
+        // Every texel read once (a streamed line: what leaves box 0's window comes from a ring); a
+        // streamed wrapping row also reads its overrun (a plain line reads nothing outside itself).
+        plan.texel_reads += lines * (n + (wrap && !whole ? overrun : 0));
         plan.fused_lines += lines;
         axis_fused[axis] = true;
       } else {

@@ -81,21 +81,21 @@ TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   EXPECT_GE(p64.radii[0][0], 30u);
   EXPECT_EQ(p200.fused_lines, 0u);
   EXPECT_EQ(p200.dispatches, 6u);
-  // A small chart beside the big one at radius 16: its lines are short against the radius, so
-  // they take the cascade while the big chart's are fused: per axis one fused and three cascade
-  // dispatches. With fused_blur off everything is the cascade.
+  // A small chart beside the big one at radius 200: the big chart's lines are too long for
+  // private memory and the radius too large for the rings, so they take the cascade; the small
+  // chart's lines run whole in private memory: per axis one fused and three cascade dispatches.
+  // With fused_blur off everything is the cascade.
   AtlasMapping two = a;
   two.charts[0].width = 2000;
   two.charts.push_back({Chart::Kind::Sheet, 2010, 2, 20, 30, false, 10.0f});
-  DiffuseOptions r16;
-  r16.radius_px = 16.0f;
-  const BlurPlan mixed = plan_blur(two, r16);
-  EXPECT_EQ(mixed.fused[0], (std::array<bool, 2>{true, true}));
-  EXPECT_EQ(mixed.fused[1], (std::array<bool, 2>{false, false}));
+  const BlurPlan mixed = plan_blur(two, r200);
+  EXPECT_EQ(mixed.fused[0], (std::array<bool, 2>{false, false}));
+  EXPECT_EQ(mixed.fused[1], (std::array<bool, 2>{true, true}));
   EXPECT_EQ(mixed.dispatches, 8u);
-  r16.fused_blur = false;
-  EXPECT_EQ(plan_blur(two, r16).fused_lines, 0u);
-  EXPECT_EQ(plan_blur(two, r16).dispatches, 6u);
+  DiffuseOptions off = r200;
+  off.fused_blur = false;
+  EXPECT_EQ(plan_blur(two, off).fused_lines, 0u);
+  EXPECT_EQ(plan_blur(two, off).dispatches, 6u);
 }
 
 TEST(DiffusePlan, KRingForSigmaPutsTheLastRingNearTwoSigma) {
@@ -216,9 +216,10 @@ TEST_F(Diffuse, CylindricalChartsWrap) {
   }
 }
 
-// The fused blur (three boxes per axis in one dispatch, rings in private memory) gives the
-// six-dispatch cascade's values to float rounding: wrapping and plain charts, radii from one
-// texel up, fused and cascade lines mixed in one run, vertices and the dilated atlas.
+// The fused blur (three boxes per axis in one dispatch: short lines whole in private memory,
+// long ones streamed through rings) gives the six-dispatch cascade's values to float rounding:
+// wrapping and plain charts, both fused ways, radii from one texel up, fused and cascade lines
+// mixed in one run, vertices and the dilated atlas.
 TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
   const test::CylinderGrid g;
   const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
@@ -227,24 +228,27 @@ TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
     AtlasMapping a;
     float radius;
   };
-  // Both mappings in one atlas: the wrapping chart, and the four split charts beside it carrying
-  // copies of the triangles (the vertices stay in the wrapping chart; the atlas shows all).
-  AtlasMapping both = test::cylinder_wrapping_mapping(m, g, 1024);
+  test::CylinderGrid fine = g;  // a 513 x 327 wrapping chart: its rows and columns stream
+  fine.texels_per_column = 8;
+  // Both mappings in one atlas: the fine wrapping chart, and the four split charts (97 x 164,
+  // whole in private memory) beside it carrying copies of the triangles (the vertices stay in the
+  // wrapping chart; the atlas shows all).
+  AtlasMapping both = test::cylinder_wrapping_mapping(m, fine, 1024);
   const AtlasMapping split = test::cylinder_split_mapping(m, g, 1024, 4, 4);
   const auto first = static_cast<std::uint32_t>(both.charts.size());
   for (Chart ch : split.charts) {
-    ch.x0 += 300;
+    ch.x0 += 530;
     both.charts.push_back(ch);
   }
   for (AtlasTriangle t : split.triangles) {
     t.chart += first;
-    for (glm::vec2& uv : t.uv) uv.x += 300.0f;
+    for (glm::vec2& uv : t.uv) uv.x += 530.0f;
     both.triangles.push_back(t);
   }
-  // Radius 40 on the wrapping chart: its rows (257 texels) take the cascade, its columns are
-  // fused, in the same run; radius 24 on both: the wrapping chart's rows take the cascade, the
-  // split charts' rows are fused, in the same axis.
-  const std::vector<Case> cases = {{both, 24.0f},
+  // Radius 12: every line fused, both ways; radius 48: the wrapping chart's rows overrun too far
+  // and take the cascade while the split charts' rows are fused, in the same axis.
+  const std::vector<Case> cases = {{both, 12.0f},
+                                   {both, 48.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 1.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 8.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 40.0f},
@@ -258,8 +262,8 @@ TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
     box.fused_blur = false;
     const DiffuseResult f = diffuser_->run(m, c.a, u, fused), b = diffuser_->run(m, c.a, u, box);
     EXPECT_GT(f.plan.fused_lines, 0u) << c.radius;
-    EXPECT_EQ(f.plan.cascade_lines > 0, c.radius == 40.0f || c.radius == 24.0f) << c.radius;
-    if (c.radius == 24.0f) {
+    EXPECT_EQ(f.plan.cascade_lines > 0, c.radius == 48.0f) << c.radius;
+    if (c.radius == 48.0f) {
       EXPECT_EQ(f.plan.fused[0], (std::array<bool, 2>{false, true}));
       EXPECT_EQ(f.plan.fused[1], (std::array<bool, 2>{true, true}));
     }

@@ -70,11 +70,12 @@ struct DiffuseTimings {
 // interpolation over triangles contributes (mean edge² / 4 per axis, see diffuse.cpp) is taken off the blur's.
 struct BlurPlan {
   std::vector<std::array<std::uint32_t, 3>> radii;  // per chart
-  // Per chart, rows then columns: walked by the fused shader (the three boxes of an axis in one
-  // walk, windows through ring buffers) rather than the cascade (one dispatch per box). Fused
-  // where the radii fit its rings (passes/atlas_passes.hpp kFusedMaxRadius) and the walk's overrun
-  // past the line (r1 + r2, a wrapping row 2 (r0 + r1 + r2)) is at most half the line, since each
-  // fused step costs about two cascade steps; never with DiffuseOptions::fused_blur off.
+  // Per chart, rows then columns: blurred by the fused shader (the three boxes of an axis in one
+  // dispatch) rather than the cascade (one dispatch per box). Fused: lines up to
+  // passes::kShortLine texels (whole in private memory, any radius), and longer lines whose radii
+  // fit the rings (kFusedMaxRadius) and whose walk's overrun past the line (r1 + r2, a wrapping
+  // row 2 (r0 + r1 + r2)) is at most half the line, since a streamed step costs about two cascade
+  // steps. Never with DiffuseOptions::fused_blur off.
   std::vector<std::array<bool, 2>> fused;
   std::uint64_t fused_lines = 0, cascade_lines = 0;
   std::uint32_t dispatches = 0;    // compute dispatches of the blur: per axis 1 fused + 3 cascade, when used
