@@ -1,17 +1,18 @@
 #version 450
 // Atlas blur: the Gaussian's three box filters along one axis in one dispatch. One invocation
-// per job = one row (axis 0) or column (axis 1) of one chart, walked once with three running
-// sums: box 0 over the source, boxes 1 and 2 over the previous box's output. What leaves a window
-// (the source texel, box 0's and box 1's output 2r + 1 steps back) comes from private ring
-// buffers, so each source texel is read once and only box 2's output is written: lavapipe turns
-// every storage-buffer access into a per-lane loop, and the one-dispatch-per-box cascade
-// (atlas_blur_box.comp) made six such accesses per texel and box where this makes two per axis.
-// Every box sees zeros outside the chart's rectangle (the previous box's output is not extended
-// past it), rows of a wrapping chart wrap instead, so nothing enters from another chart or the
-// gutter. Both channels (value · coverage, coverage) are blurred (normalized convolution). The
-// sums are the cascade's term for term on plain lines; wrapping rows start their walk r1 + r2
-// texels early, so those agree to float rounding. plan_blur sends a line here only when its
-// radii fit the rings and the walk's overrun past the line is small against it.
+// per job = one row (axis 0) or column (axis 1) of one chart, read once and written once:
+// lavapipe turns every storage-buffer access into a per-lane loop, and the one-dispatch-per-box
+// cascade (atlas_blur_box.comp) made six such accesses per texel and box where this makes two per
+// axis. A line of up to kRing texels is read into private memory and the three boxes run there
+// (BOX). A longer line is walked once with three running sums (box 0 over the source, boxes 1 and
+// 2 over the previous box's output); what leaves a window (the source texel, box 0's and box 1's
+// output 2r + 1 steps back) comes from private ring buffers. Every box sees zeros outside the
+// chart's rectangle (the previous box's output is not extended past it), rows of a wrapping chart
+// wrap instead, so nothing enters from another chart or the gutter. Both channels (value ·
+// coverage, coverage) are blurred (normalized convolution). The sums are the cascade's term for
+// term except on streamed wrapping rows, which start their walk r1 + r2 texels early and agree to
+// float rounding. plan_blur sends a long line here only when its radii fit the rings and the
+// walk's overrun past the line is small against it.
 #extension GL_GOOGLE_include_directive : require
 #include "atlas_common.glsl"
 

@@ -71,7 +71,8 @@ vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaster
 // The separable Gaussian: three boxes along x (rows), then three along y (columns), between
 // `texels` (read row-major by the first passes) and `scratch`, both tiled_texel_bytes. Each line
 // goes one of two ways, chosen per chart and axis by plan_blur: fused (atlas_blur.comp,
-// `pipeline`: the three boxes in one walk, windows through ring buffers) or the cascade
+// `pipeline`: the three boxes in one dispatch, a short line whole in private memory, a long one
+// streamed with its windows through ring buffers) or the cascade
 // (atlas_blur_box.comp, `box_pipeline`: one dispatch per box, ping-ponging). The jobs (uvec2
 // chart, line) lie in this order: fused rows, cascade rows, fused columns, cascade columns. Both
 // ways end each axis in the same buffer, so an axis is a fused dispatch and three cascade

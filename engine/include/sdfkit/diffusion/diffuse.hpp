@@ -47,9 +47,9 @@ struct DiffuseOptions {
   // blur's cost is the difference of two wall times (lavapipe's per-pass timestamps are not
   // reliable: it bins draws and rasterizes them later). The values are then meaningless.
   bool blur = true;
-  // false: the blur as one dispatch per box (the six-dispatch cascade the fused shader replaced,
-  // also the fallback for radii beyond its rings): the same values to float rounding, for
-  // comparison (the benchmark's fused-vs-cascade column, tests/diffusion).
+  // false: every line through the one-dispatch-per-box cascade (what the fused shader replaced
+  // where it pays, BlurPlan::fused): the same values to float rounding, for comparison (the
+  // benchmark's cascade columns, tests/diffusion).
   bool fused_blur = true;
 };
 
