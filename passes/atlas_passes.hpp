@@ -68,17 +68,28 @@ struct AtlasRasterPass {
 };
 vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& pass);
 
-// The separable box cascade: three boxes along x (rows, `row_jobs` uvec2 jobs from offset 0),
-// then three along y (`column_jobs` from offset row_jobs), ping-ponging between `texels` (read
-// row-major by the first pass) and `scratch`, both tiled_texel_bytes. Returns the blurred, tiled
+// The separable Gaussian: three boxes along x (rows), then three along y (columns), between
+// `texels` (read row-major by the first passes) and `scratch`, both tiled_texel_bytes. Each line
+// goes one of two ways, chosen per chart and axis by plan_blur: fused (atlas_blur.comp,
+// `pipeline`: the three boxes in one dispatch, a short line whole in private memory, a long one
+// streamed with its windows through ring buffers) or the cascade
+// (atlas_blur_box.comp, `box_pipeline`: one dispatch per box, ping-ponging). The jobs (uvec2
+// chart, line) lie in this order: fused rows, cascade rows, fused columns, cascade columns. Both
+// ways end each axis in the same buffer, so an axis is a fused dispatch and three cascade
+// dispatches over disjoint charts, each left out when it has no line. Returns the blurred, tiled
 // texel buffer (a version of `texels`).
 struct AtlasBlurPass {
   const vk::Pipeline* pipeline = nullptr;
+  const vk::Pipeline* box_pipeline = nullptr;
   vk::BufferHandle texels, scratch, charts, jobs;
-  std::uint32_t row_jobs = 0, column_jobs = 0, size = 0;
+  std::uint32_t rows_fused = 0, rows_cascade = 0, columns_fused = 0, columns_cascade = 0, size = 0;
 };
 vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& pass);
-inline constexpr std::uint32_t kBlurDispatches = 6;
+// The largest box radius the fused shader's rings hold (glsl/atlas_blur.comp kRing = 256 >=
+// 2 · 127 + 1).
+inline constexpr std::uint32_t kFusedMaxRadius = 127;
+// Lines up to this many texels the fused shader runs whole in private memory, at any radius.
+inline constexpr std::uint32_t kShortLine = 256;
 
 // Per vertex: the normalized bilinear read of the blurred texels. Returns the written `values`.
 struct AtlasSamplePass {

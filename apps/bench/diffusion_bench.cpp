@@ -16,6 +16,7 @@
 #include <cmath>
 #include <numbers>
 #include <cstdio>
+#include <ctime>
 #include <sstream>
 
 namespace sdfkit::bench {
@@ -90,9 +91,14 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
      << o.atlas_size << "², median of " << o.repeats << " warm runs. prepare: host (triangle soup, jobs, queries "
      << "into upload memory); raster+sample: the graph without the blur passes (raster, copy, sample), wall time; "
      << "blur: the full graph's wall time minus that; read-back: values out of mapped memory; total: diffuse() "
-     << "end to end (prepare + graph + read-back).\n\n";
-  md << "| mesh | vertices | skeleton s | mapping ms | radius px | prepare ms | raster+sample ms | blur ms | read-back ms | total ms |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+     << "end to end (prepare + graph + read-back); blur, 6-dispatch cascade: the same blur as one dispatch per box "
+     << "(DiffuseOptions::fused_blur = false, the form before the fused shader), timed the same way in the same runs; "
+     << "CPU ms: the process's CPU time (all threads, lavapipe's included) of the run less that of the run without "
+     << "the blur, which a loaded machine inflates far less than wall time. "
+     << "lavapipe's timestamps around the blur's dispatches read ~0.1 ms (it records, then runs the whole "
+     << "submission), so times here are wall-time differences.\n\n";
+  md << "| mesh | vertices | skeleton s | mapping ms | radius px | prepare ms | raster+sample ms | blur ms | read-back ms | total ms | blur, 6-dispatch cascade ms | blur CPU ms | cascade CPU ms |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   std::ostringstream kmd;
   kmd << "\nk-ring smoothing on the same meshes (engine/post/smooth, all cores):\n\n| mesh | vertices |";
   for (int k : o.rings) kmd << " k=" << k << " ms |";
@@ -135,30 +141,49 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
       diffusion::DiffuseOptions d;
       d.radius_px = radius;
       diffuser.run(bm.mesh, mapping, u, d);  // warm-up
-      std::vector<double> raster, blur, sample, readback, total, unblurred;
+      std::vector<double> raster, blur, sample, readback, total, unblurred, cascade, cpu_blur, cpu_cascade;
+      const auto cpu_ms = [](std::clock_t a, std::clock_t b) { return 1000.0 * static_cast<double>(b - a) / CLOCKS_PER_SEC; };
       diffusion::DiffuseOptions nb = d;
       nb.blur = false;
+      diffusion::DiffuseOptions box = d;  // the six-dispatch cascade the fused blur replaced
+      box.fused_blur = false;
+      diffuser.run(bm.mesh, mapping, u, box);  // warm-up
       for (int r = 0; r < o.repeats; ++r) {
+        // CPU time of the whole process (lavapipe's worker threads included) beside the wall
+        // time: on a shared machine it is what the blur itself cost, whatever else runs.
+        std::clock_t c0 = std::clock();
         unblurred.push_back(diffuser.run(bm.mesh, mapping, u, nb).timings.execute);
+        const std::clock_t c1 = std::clock();
         const diffusion::DiffuseResult res = diffuser.run(bm.mesh, mapping, u, d);
+        const std::clock_t c2 = std::clock();
+        const double cpu_unblurred = cpu_ms(c0, c1);
+        cpu_blur.push_back(cpu_ms(c1, c2) - cpu_unblurred);
         raster.push_back(unblurred.back());
         blur.push_back(res.timings.execute - unblurred.back());
         sample.push_back(res.timings.prepare);
         readback.push_back(res.timings.readback);
         total.push_back(res.timings.total);
+        c0 = std::clock();
+        cascade.push_back(diffuser.run(bm.mesh, mapping, u, box).timings.execute - unblurred.back());
+        cpu_cascade.push_back(cpu_ms(c0, std::clock()) - cpu_unblurred);
       }
       nlohmann::json jr;
       jr["radius_px"] = radius;
       jr["prepare_ms"] = median(sample);
       jr["raster_sample_ms"] = median(raster);
       jr["blur_ms"] = median(blur);
+      jr["blur_cascade_ms"] = median(cascade);
+      jr["blur_cpu_ms"] = median(cpu_blur);
+      jr["blur_cascade_cpu_ms"] = median(cpu_cascade);
+      jr["blur_dispatches"] = diffusion::plan_blur(mapping, d).dispatches;
       jr["readback_ms"] = median(readback);
       jr["total_ms"] = median(total);
       jm["radii"].push_back(jr);
       char line[512];
-      std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f |\n",
+      std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %.0f |\n",
                     bm.name.c_str(), bm.mesh.vertex_count(), skeleton_s, mapping_ms, static_cast<double>(radius),
-                    median(sample), median(raster), median(blur), median(readback), median(total));
+                    median(sample), median(raster), median(blur), median(readback), median(total), median(cascade),
+                    median(cpu_blur), median(cpu_cascade));
       md << line;
     }
     kmd << "| " << bm.name << " | " << bm.mesh.vertex_count() << " |";

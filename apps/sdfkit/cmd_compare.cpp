@@ -1,7 +1,9 @@
 // sdfkit compare: two results on the same mesh -> Pearson correlation, relative differences and
 // their histogram; with -o a picture coloured white (equal) to red (>= 5% apart), as in the
-// paper's Figures 6 and 9.
+// paper's Figures 6 and 9. With --diffusion: one result smoothed by heat diffusion, k-ring and
+// texture space, side by side (compare_diffusion.cpp).
 #include "commands.hpp"
+#include "compare_diffusion.hpp"
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/io/field.hpp"
@@ -89,8 +91,24 @@ void add_compare_command(CLI::App& app) {
     int views = 4, width = 1600, height = 900;
   };
   auto a = std::make_shared<Args>();
+  auto d = std::make_shared<DiffusionCompareArgs>();
+  auto diffusion = std::make_shared<bool>(false);
   cmd->add_option("A", a->a, "Result: .glb/.gltf (_SDF), .ply (quality) or .txt (with --mesh)")->required();
-  cmd->add_option("B", a->b, "Reference result, same kinds as A")->required();
+  cmd->add_option("B", a->b, "Reference result, same kinds as A (not with --diffusion)");
+  // --diffusion (issue 13): A smoothed three ways at each sigma, k-ring and texture space against heat diffusion.
+  cmd->add_flag("--diffusion", *diffusion,
+                "Instead: smooth A (per vertex) by heat diffusion, k-ring smoothing and texture-space diffusion at each "
+                "sigma and print how far k-ring and texture space are from heat diffusion");
+  cmd->add_option("--sigma", d->sigmas, "--diffusion: Gaussian sigmas in model units")->delimiter(',')->check(CLI::PositiveNumber);
+  cmd->add_option("--sigma-edges", d->sigma_edges, "--diffusion: Gaussian sigmas in mean edge lengths")
+      ->delimiter(',')->check(CLI::PositiveNumber);
+  cmd->add_option("--atlas-size", d->atlas_size, "--diffusion: texture space's atlas side (default 2048)")
+      ->check(CLI::Range(16, 16384));
+  cmd->add_option("--skeleton", d->skeleton, "--diffusion: skeleton JSON of the mesh (default: extracted)");
+  cmd->add_option("--device", d->device, "--diffusion: Vulkan device (index or name)");
+  cmd->add_option("--heat-steps", d->heat_steps, "--diffusion: implicit steps of the heat reference (default 8)")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--json", d->json, "--diffusion: also write the table as JSON");
   cmd->add_option("--mesh", a->mesh, "The mesh the .txt values belong to");
   cmd->add_option("-o,--output", a->output, "PNG of the mesh coloured white (equal) to red (>= --limit apart)");
   cmd->add_option("--limit", a->limit, "Relative difference drawn full red (default 0.05 = 5%)")
@@ -101,7 +119,22 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--weld-tolerance", a->load.weld_tolerance, "Weld positions closer than this (model units; default 1e-6 of the bounding box, 0 = bitwise-equal only)")
       ->check(CLI::NonNegativeNumber);
   add_asset_options(*cmd, a->load);
-  cmd->callback([a] {
+  cmd->callback([a, d, diffusion, cmd] {
+    const auto given = [cmd](const char* name) { return cmd->get_option(name)->count() > 0; };
+    if (*diffusion) {
+      for (const char* k : {"B", "--output", "--limit", "--views", "--width", "--height"})
+        if (given(k)) throw UsageError(std::string(k) + " is not used by --diffusion");
+      if (d->sigmas.empty() == d->sigma_edges.empty())
+        throw UsageError("--diffusion needs exactly one of --sigma and --sigma-edges");
+      d->input = a->a;
+      d->mesh = a->mesh;
+      d->load = a->load;
+      compare_diffusion(*d);
+      return;
+    }
+    for (const char* k : {"--sigma", "--sigma-edges", "--atlas-size", "--skeleton", "--device", "--heat-steps", "--json"})
+      if (given(k)) throw UsageError(std::string(k) + " needs --diffusion");
+    if (a->b.empty()) throw UsageError("compare needs two results, A and B (or --diffusion)");
     if (!a->output.empty()) check_png_name(a->output);
     std::optional<io::Asset> mesh;
     if (!a->mesh.empty()) mesh = load_input(a->mesh, a->load);

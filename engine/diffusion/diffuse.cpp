@@ -100,7 +100,7 @@ std::array<std::uint32_t, 3> box_radii(float sigma_px) {
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge) {
   check_options(options);
   BlurPlan plan;
-  plan.dispatches = passes::kBlurDispatches;
+  bool axis_fused[2] = {false, false}, axis_cascade[2] = {false, false};
   for (const Chart& c : mapping.charts) {
     auto r = box_radii(sigma_px_of(c, options, mean_edge));
     // A periodic box no wider than the period (the shader wraps an index once at most).
@@ -108,12 +108,31 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, f
       for (std::uint32_t& x : r) x = std::min(x, c.width > 1 ? (c.width - 1) / 2 : 0u);
     plan.radii.push_back(r);
     plan.line_jobs += std::uint64_t{c.width} + c.height;
-    for (std::uint32_t box = 0; box < 3; ++box) {
-      const std::uint64_t window = 2ull * r[box] + 1;
-      plan.texel_reads += std::uint64_t{c.height} * (2ull * c.width + window);  // rows
-      plan.texel_reads += std::uint64_t{c.width} * (2ull * c.height + window);  // columns
+    std::array<bool, 2> fused{};
+    for (int axis = 0; axis < 2; ++axis) {
+      const std::uint64_t n = axis == 0 ? c.width : c.height, lines = axis == 0 ? c.height : c.width;
+      const bool wrap = axis == 0 && c.wraps_x;
+      const std::uint64_t e[3] = {r[0], r[1], r[2]};
+      const std::uint64_t overrun = wrap ? 2 * (e[0] + e[1] + e[2]) : e[1] + e[2];
+      // A short line runs whole in private memory (any radius); a longer one streams.
+      const bool whole = n <= passes::kShortLine;
+      fused[static_cast<std::size_t>(axis)] =
+          options.fused_blur && (whole || (std::max({e[0], e[1], e[2]}) <= passes::kFusedMaxRadius && 2 * overrun <= n));
+      if (fused[static_cast<std::size_t>(axis)]) {
+        // Every texel read once (a streamed line: what leaves box 0's window comes from a ring); a
+        // streamed wrapping row also reads its overrun (a plain line reads nothing outside itself).
+        plan.texel_reads += lines * (n + (wrap && !whole ? overrun : 0));
+        plan.fused_lines += lines;
+        axis_fused[axis] = true;
+      } else {
+        for (int b = 0; b < 3; ++b) plan.texel_reads += lines * (2 * n + 2ull * r[static_cast<std::size_t>(b)] + 1);
+        plan.cascade_lines += lines;
+        axis_cascade[axis] = true;
+      }
     }
+    plan.fused.push_back(fused);
   }
+  for (int axis = 0; axis < 2; ++axis) plan.dispatches += (axis_fused[axis] ? 1u : 0u) + (axis_cascade[axis] ? 3u : 0u);
   return plan;
 }
 
@@ -170,11 +189,12 @@ struct Diffuser::Impl {
       : ctx(c),
         raster(make_raster_pipeline(c)),
         blur(make_compute(c, "atlas_blur.comp", 4, sizeof(passes::BlurPush))),
+        blur_box(make_compute(c, "atlas_blur_box.comp", 4, sizeof(passes::BlurPush))),
         sample(make_compute(c, "atlas_sample.comp", 4, sizeof(passes::SamplePush))),
         dilate(make_compute(c, "atlas_dilate.comp", 3, sizeof(passes::DilatePush))),
         transients(c) {}
   vk::Context& ctx;
-  vk::Pipeline raster, blur, sample, dilate;
+  vk::Pipeline raster, blur, blur_box, sample, dilate;
   vk::TransientPool transients;
 };
 
@@ -243,15 +263,21 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
                                     vk::MemoryUse::Upload);
   if (!soup.empty()) std::memcpy(soup_buf.mapped(), soup.data(), soup.size() * sizeof(passes::RasterVertex));
 
-  // Line jobs of the blur: every row of every chart, then every column.
+  // Line jobs of the blur: the rows of the charts whose rows are fused, the other rows, then the
+  // columns likewise (passes/atlas_passes.hpp AtlasBlurPass).
   std::vector<glm::uvec2> jobs;
   jobs.reserve(result.plan.line_jobs);
-  for (std::uint32_t c = 0; c < charts.size(); ++c)
-    for (std::uint32_t y = 0; y < mapping.charts[c].height; ++y) jobs.emplace_back(c, y);
-  const auto row_jobs = static_cast<std::uint32_t>(jobs.size());
-  for (std::uint32_t c = 0; c < charts.size(); ++c)
-    for (std::uint32_t x = 0; x < mapping.charts[c].width; ++x) jobs.emplace_back(c, x);
-  const auto column_jobs = static_cast<std::uint32_t>(jobs.size()) - row_jobs;
+  std::uint32_t counts[4] = {};
+  for (int axis = 0; axis < 2; ++axis)
+    for (int want_fused = 1; want_fused >= 0; --want_fused) {
+      const std::size_t before = jobs.size();
+      for (std::uint32_t c = 0; c < charts.size(); ++c) {
+        if (result.plan.fused[c][static_cast<std::size_t>(axis)] != (want_fused == 1)) continue;
+        const std::uint32_t lines = axis == 0 ? mapping.charts[c].height : mapping.charts[c].width;
+        for (std::uint32_t l = 0; l < lines; ++l) jobs.emplace_back(c, l);
+      }
+      counts[2 * axis + (1 - want_fused)] = static_cast<std::uint32_t>(jobs.size() - before);
+    }
   vk::Buffer job_buf = make_buffer(ctx, jobs.size() * sizeof(glm::uvec2), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                    vk::MemoryUse::Upload);
   if (!jobs.empty()) std::memcpy(job_buf.mapped(), jobs.data(), jobs.size() * sizeof(glm::uvec2));
@@ -291,12 +317,15 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
 
   passes::AtlasBlurPass bp;
   bp.pipeline = &impl_->blur;
+  bp.box_pipeline = &impl_->blur_box;
   bp.texels = rastered;
   bp.scratch = scratch;
   bp.charts = chart_h;
   bp.jobs = job_h;
-  bp.row_jobs = row_jobs;
-  bp.column_jobs = column_jobs;
+  bp.rows_fused = counts[0];
+  bp.rows_cascade = counts[1];
+  bp.columns_fused = counts[2];
+  bp.columns_cascade = counts[3];
   bp.size = size;
   const auto blurred = options.blur ? passes::add_atlas_blur_passes(graph, bp) : rastered;
 

@@ -5,18 +5,90 @@
 #include "run.hpp"
 #include "scratch.hpp"
 
+#include "sdfkit/core/shapes.hpp"
 #include "sdfkit/io/field.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <cmath>
+#include <map>
 
 namespace sdfkit::test {
 namespace {
 
 const std::string kCli = SDFKIT_CLI;
+
+// A capped cylinder (radius 1, length 6) as OFF and a field on it as .txt: a step at mid-length,
+// a slope along the axis and waves around it.
+void write_cylinder_and_field(const std::string& off, const std::string& txt) {
+  const Mesh m = shapes::capped_cylinder(1.0f, 6.0f, 64, 60, 8);
+  std::ofstream o(off), t(txt);
+  o << "OFF\n" << m.vertex_count() << " " << m.face_count() << " 0\n";
+  for (const glm::vec3& p : m.positions) {
+    o << p.x << " " << p.y << " " << p.z << "\n";
+    t << 2.0f + 0.4f * std::sin(3.0f * std::atan2(p.y, p.x)) + 0.3f * p.z + (p.z > 0.0f ? 0.5f : 0.0f) << "\n";
+  }
+  for (const auto& f : m.triangles) o << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
+}
+
+// `sdfkit compare --diffusion`: heat diffusion, k-ring and texture space side by side at sigma =
+// 1 and 10 mean edge lengths on a capped cylinder through the skeleton texture mapping (its bone
+// chart is close to isometric): heat against itself is exact, texture space stays within
+// Pearson 0.95 and 5 % median of heat diffusion up to 10 edges, k-ring uses K = 2 sigma / edge.
+TEST(DiffuseCli, CompareDiffusionPutsKRingAndTextureSpaceBesideHeat) {
+  ScratchDir dir;
+  const std::string off = dir.path("cyl.off"), txt = dir.path("cyl.txt"), json = dir.path("rows.json");
+  write_cylinder_and_field(off, txt);
+  const CommandResult r = run_command(kCli + " compare " + txt + " --mesh " + off +
+                                          " --diffusion --sigma-edges 1,10 --atlas-size 1024 --json " + json,
+                                      dir.dir());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| method | pearson | median relative | rms |"), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["rows"].size(), 6u);
+  std::map<std::pair<int, std::string>, nlohmann::json> rows;
+  for (const auto& row : j["rows"]) rows[{static_cast<int>(std::lround(row["sigma_edges"].get<double>())), row["method"]}] = row;
+  for (int e : {1, 10}) {
+    const auto& heat = rows.at({e, "heat"});
+    EXPECT_EQ(heat["pearson"].get<double>(), 1.0);
+    EXPECT_EQ(heat["rms"].get<double>(), 0.0);
+    EXPECT_NEAR(heat["sigma"].get<double>(), e * j["mean_edge"].get<double>(), 1e-9);
+    const auto& tex = rows.at({e, "texture"});
+    EXPECT_GE(tex["pearson"].get<double>(), 0.95) << e;
+    EXPECT_LE(tex["median_relative"].get<double>(), 0.05) << e;
+    EXPECT_GT(tex["rms"].get<double>(), 0.0) << e;  // not the heat values themselves
+    const auto& kring = rows.at({e, "k-ring"});
+    EXPECT_EQ(kring["rings"].get<int>(), 2 * e);
+    EXPECT_GE(kring["pearson"].get<double>(), 0.95) << e;
+  }
+  // Texture space's distance from heat diffusion grows with sigma (the bone chart ends at the
+  // caps, which the blur does not cross); a run that ignored sigma would give equal rows.
+  EXPECT_LT(rows.at({1, "texture"})["rms"].get<double>(), rows.at({10, "texture"})["rms"].get<double>());
+}
+
+TEST(DiffuseCli, CompareDiffusionUsageErrorsExitTwo) {
+  ScratchDir dir;
+  const std::string off = dir.path("cyl.off"), txt = dir.path("cyl.txt"), json = dir.path("rows.json");
+  write_cylinder_and_field(off, txt);
+  const std::string base = kCli + " compare " + txt + " --mesh " + off + " ";
+  for (const std::string& args : {"--diffusion --json " + json, "--diffusion --sigma 0.1 --sigma-edges 1 --json " + json,
+                                 "--sigma-edges 1 --json " + json, "--diffusion --sigma-edges 1 " + txt + " --json " + json,
+                                 "--diffusion --sigma-edges 0 --json " + json, "--json " + json}) {
+    const CommandResult r = run_command(base + args, dir.dir());
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+    EXPECT_FALSE(std::filesystem::exists(json)) << args;
+  }
+  // A mesh without values is an input error (exit 1), not a usage error.
+  const CommandResult r = run_command(kCli + " compare " + off + " --diffusion --sigma-edges 1", dir.dir());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.exit_code, 2) << r.err;
+}
 
 TEST(DiffuseCli, UsageErrorsExitTwo) {
   ScratchDir dir;

@@ -59,22 +59,43 @@ TEST(DiffusePlan, BoxCascadeHasTheGaussiansVariance) {
   EXPECT_EQ(box_radii(0.0f), (std::array<std::uint32_t, 3>{0, 0, 0}));
 }
 
-// The blur's work (reads per pass, dispatches) on a 2048² atlas: radius 64 costs what radius 2
-// costs (the running sums read each texel twice whatever the radius; only the window's warm-up
-// grows).
+// The blur's work (reads, dispatches) on a 2048² atlas: radius 64 costs what radius 2 costs (the
+// running sums read each texel once (fused) or twice per box (cascade) whatever the radius; only
+// the windows' warm-up and the fused walk's overrun grow), both fused in two dispatches. Radii
+// beyond the fused shader's rings, and lines short against their radii, take the cascade.
 TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   AtlasMapping a;
   a.size = 2048;
   a.charts.push_back({Chart::Kind::Bone, 2, 2, 2044, 2044, true, 10.0f});
-  DiffuseOptions r2, r64;
+  DiffuseOptions r2, r64, r200;
   r2.radius_px = 2.0f;
   r64.radius_px = 64.0f;
-  const BlurPlan p2 = plan_blur(a, r2), p64 = plan_blur(a, r64);
-  EXPECT_EQ(p2.dispatches, 6u);
+  r200.radius_px = 200.0f;
+  const BlurPlan p2 = plan_blur(a, r2), p64 = plan_blur(a, r64), p200 = plan_blur(a, r200);
+  EXPECT_EQ(p2.dispatches, 2u);
+  EXPECT_EQ(p2.fused_lines, 2u * 2044u);
   EXPECT_EQ(p64.dispatches, p2.dispatches);
+  EXPECT_EQ(p64.fused_lines, p2.fused_lines);
   EXPECT_EQ(p64.line_jobs, p2.line_jobs);
   EXPECT_LE(static_cast<double>(p64.texel_reads), 1.1 * static_cast<double>(p2.texel_reads));
   EXPECT_GE(p64.radii[0][0], 30u);
+  EXPECT_EQ(p200.fused_lines, 0u);
+  EXPECT_EQ(p200.dispatches, 6u);
+  // A small chart beside the big one at radius 200: the big chart's lines are too long for
+  // private memory and the radius too large for the rings, so they take the cascade; the small
+  // chart's lines run whole in private memory: per axis one fused and three cascade dispatches.
+  // With fused_blur off everything is the cascade.
+  AtlasMapping two = a;
+  two.charts[0].width = 2000;
+  two.charts.push_back({Chart::Kind::Sheet, 2010, 2, 20, 30, false, 10.0f});
+  const BlurPlan mixed = plan_blur(two, r200);
+  EXPECT_EQ(mixed.fused[0], (std::array<bool, 2>{false, false}));
+  EXPECT_EQ(mixed.fused[1], (std::array<bool, 2>{true, true}));
+  EXPECT_EQ(mixed.dispatches, 8u);
+  DiffuseOptions off = r200;
+  off.fused_blur = false;
+  EXPECT_EQ(plan_blur(two, off).fused_lines, 0u);
+  EXPECT_EQ(plan_blur(two, off).dispatches, 6u);
 }
 
 TEST(DiffusePlan, KRingForSigmaPutsTheLastRingNearTwoSigma) {
@@ -192,6 +213,76 @@ TEST_F(Diffuse, CylindricalChartsWrap) {
     EXPECT_NEAR(at(seam, -d), at(seam, d), 1e-3f * at(seam, d)) << d;     // symmetric across the seam
     EXPECT_NEAR(at(seam, -d), at(middle, 32 - d), 1e-3f * at(seam, d)) << d;  // as in the middle
     EXPECT_GT(at(seam, -d), 1.05f);
+  }
+}
+
+// The fused blur (three boxes per axis in one dispatch: short lines whole in private memory,
+// long ones streamed through rings) gives the six-dispatch cascade's values to float rounding:
+// wrapping and plain charts, both fused ways, radii from one texel up, fused and cascade lines
+// mixed in one run, vertices and the dilated atlas.
+TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const std::vector<float> u = test_field(m);
+  struct Case {
+    AtlasMapping a;
+    float radius;
+  };
+  test::CylinderGrid fine = g;  // a 513 x 327 wrapping chart: its rows and columns stream
+  fine.texels_per_column = 8;
+  // Both mappings in one atlas: the fine wrapping chart, and the four split charts (97 x 164,
+  // whole in private memory) beside it carrying copies of the triangles (the vertices stay in the
+  // wrapping chart; the atlas shows all).
+  AtlasMapping both = test::cylinder_wrapping_mapping(m, fine, 1024);
+  const AtlasMapping split = test::cylinder_split_mapping(m, g, 1024, 4, 4);
+  const auto first = static_cast<std::uint32_t>(both.charts.size());
+  for (Chart ch : split.charts) {
+    ch.x0 += 530;
+    both.charts.push_back(ch);
+  }
+  for (AtlasTriangle t : split.triangles) {
+    t.chart += first;
+    for (glm::vec2& uv : t.uv) uv.x += 530.0f;
+    both.triangles.push_back(t);
+  }
+  // Radius 12: every line fused, both ways; radius 48: the wrapping chart's rows overrun too far
+  // and take the cascade while the split charts' rows are fused, in the same axis.
+  const std::vector<Case> cases = {{both, 12.0f},
+                                   {both, 48.0f},
+                                   {test::cylinder_wrapping_mapping(m, g, 512), 1.0f},
+                                   {test::cylinder_wrapping_mapping(m, g, 512), 8.0f},
+                                   {test::cylinder_wrapping_mapping(m, g, 512), 40.0f},
+                                   {test::cylinder_split_mapping(m, g, 1024, 4, 4), 3.0f},
+                                   {test::cylinder_split_mapping(m, g, 1024, 4, 4), 12.0f}};
+  for (const Case& c : cases) {
+    DiffuseOptions fused;
+    fused.radius_px = c.radius;
+    fused.keep_atlas = true;
+    DiffuseOptions box = fused;
+    box.fused_blur = false;
+    const DiffuseResult f = diffuser_->run(m, c.a, u, fused), b = diffuser_->run(m, c.a, u, box);
+    EXPECT_GT(f.plan.fused_lines, 0u) << c.radius;
+    EXPECT_EQ(f.plan.cascade_lines > 0, c.radius == 48.0f) << c.radius;
+    if (c.radius == 48.0f) {
+      EXPECT_EQ(f.plan.fused[0], (std::array<bool, 2>{false, true}));
+      EXPECT_EQ(f.plan.fused[1], (std::array<bool, 2>{true, true}));
+    }
+    EXPECT_EQ(b.plan.fused_lines, 0u);
+    EXPECT_EQ(b.plan.dispatches, 6u);
+    float worst = 0.0f, spread = 0.0f;
+    for (std::size_t v = 0; v < u.size(); ++v) {
+      worst = std::max(worst, std::abs(f.values[v] - b.values[v]));
+      spread = std::max(spread, std::abs(f.values[v] - f.values[0]));
+    }
+    EXPECT_LE(worst, 2e-5f) << "radius " << c.radius << " (" << c.a.charts.size() << " charts)";
+    EXPECT_GT(spread, 1e-3f) << "radius " << c.radius;  // a field that still varies
+    ASSERT_EQ(f.atlas.size(), b.atlas.size());
+    for (std::size_t i = 0; i < f.atlas.size(); ++i) {
+      ASSERT_EQ(std::isnan(f.atlas[i]), std::isnan(b.atlas[i])) << i;
+      if (!std::isnan(f.atlas[i])) {
+        ASSERT_NEAR(f.atlas[i], b.atlas[i], 2e-5f) << "radius " << c.radius << " texel " << i;
+      }
+    }
   }
 }
 

@@ -1,15 +1,14 @@
 #pragma once
-// Test-side tools for texture-space diffusion: intrinsic heat diffusion (cotangent Laplacian,
-// lumped mass, one implicit step; Eigen, tests only), analytic shapes with mappings built by
+// Test-side tools for texture-space diffusion: intrinsic heat diffusion (the library's,
+// sdfkit/diffusion/heat.hpp), analytic shapes with mappings built by
 // hand (a cylinder as one wrapping chart or as overlapping non-wrapping charts, a box as one chart
 // per side), and the seam statistic.
 
 #include "sdfkit/core/mesh.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/diffusion/atlas.hpp"
+#include "sdfkit/diffusion/heat.hpp"
 
-#include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -22,47 +21,10 @@
 
 namespace sdfkit::test {
 
-// Heat flow for time t = sigma² / 2 (the Gaussian of sigma): `steps` implicit steps
-// (M + (t / steps) L) u_{k+1} = M u_k, L the cotangent Laplacian (positive semi-definite), M the
-// lumped (barycentric) mass. One step is the resolvent (1 + t Δ)^-1, whose kernel has the
-// Gaussian's variance but a sharper peak and heavier tails; more steps converge to heat flow.
+// Heat flow for time t = sigma² / 2: the library's reference (sdfkit/diffusion/heat.hpp, `steps`
+// implicit steps with the cotangent Laplacian and the lumped mass).
 inline std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> u0, double sigma, int steps = 8) {
-  const auto V = static_cast<int>(mesh.vertex_count());
-  std::vector<Eigen::Triplet<double>> trip;
-  std::vector<double> mass(static_cast<std::size_t>(V), 0.0);
-  for (const auto& tri : mesh.triangles) {
-    const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[tri[0]]), glm::dvec3(mesh.positions[tri[1]]),
-                             glm::dvec3(mesh.positions[tri[2]])};
-    const double area = 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
-    if (!(area > 0.0)) continue;
-    for (int k = 0; k < 3; ++k) {
-      mass[tri[static_cast<std::size_t>(k)]] += area / 3.0;
-      const int i = static_cast<int>(tri[static_cast<std::size_t>((k + 1) % 3)]);
-      const int j = static_cast<int>(tri[static_cast<std::size_t>((k + 2) % 3)]);
-      const glm::dvec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
-      const double w = 0.5 * glm::dot(a, b) / glm::length(glm::cross(a, b));  // cot of the angle at k, halved
-      trip.emplace_back(i, j, -w);
-      trip.emplace_back(j, i, -w);
-      trip.emplace_back(i, i, w);
-      trip.emplace_back(j, j, w);
-    }
-  }
-  const double t = 0.5 * sigma * sigma / steps;
-  Eigen::SparseMatrix<double> A(V, V);
-  for (auto& e : trip) e = Eigen::Triplet<double>(e.row(), e.col(), t * e.value());
-  for (int v = 0; v < V; ++v) trip.emplace_back(v, v, mass[static_cast<std::size_t>(v)]);
-  A.setFromTriplets(trip.begin(), trip.end());
-  Eigen::VectorXd u(V);
-  for (int v = 0; v < V; ++v) u[v] = u0[static_cast<std::size_t>(v)];
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
-  for (int k = 0; k < steps; ++k) {
-    Eigen::VectorXd rhs(V);
-    for (int v = 0; v < V; ++v) rhs[v] = mass[static_cast<std::size_t>(v)] * u[v];
-    u = solver.solve(rhs);
-  }
-  std::vector<float> out(static_cast<std::size_t>(V));
-  for (int v = 0; v < V; ++v) out[static_cast<std::size_t>(v)] = static_cast<float>(u[v]);
-  return out;
+  return diffusion::heat_diffusion(mesh, u0, sigma, steps);
 }
 
 // An open cylinder of radius r and height h around z (shapes::open_cylinder: vertex (i, j) =

@@ -6,8 +6,8 @@
 //   atlas_raster  the AtlasTriangles, per-corner values, into an RG32F atlas (value, coverage 1),
 //                 each fragment clipped to its chart's rectangle (a triangle across the seam of a
 //                 wrapping chart is drawn once per side); copied into a texel buffer
-//   atlas_blur    a separable Gaussian as a cascade of three box filters per axis (six compute
-//                 passes), each box a running sum along a row or column of one chart: the work per
+//   atlas_blur    a separable Gaussian as a cascade of three box filters per axis (one compute
+//                 pass per axis), each box a running sum along a row or column of one chart: the work per
 //                 texel is the same at every radius. Rows of a wrapping chart wrap; outside its
 //                 rectangle a chart sees zeros, and both channels are blurred, so the value read
 //                 back is blur(value·coverage) / blur(coverage) (normalized convolution): nothing
@@ -47,13 +47,17 @@ struct DiffuseOptions {
   // blur's cost is the difference of two wall times (lavapipe's per-pass timestamps are not
   // reliable: it bins draws and rasterizes them later). The values are then meaningless.
   bool blur = true;
+  // false: every line through the one-dispatch-per-box cascade (what the fused shader replaced
+  // where it pays, BlurPlan::fused): the same values to float rounding, for comparison (the
+  // benchmark's cascade columns, tests/diffusion).
+  bool fused_blur = true;
 };
 
 // Where the time went (milliseconds). Device times only with DiffuseOptions::profile.
 struct DiffuseTimings {
   double prepare = 0.0;   // host: triangle soup, chart table and line jobs written to upload memory
   double raster = 0.0;    // device: atlas_raster (+ its copy into the texel buffer)
-  double blur = 0.0;      // device: the six box passes
+  double blur = 0.0;      // device: the blur's dispatches
   double sample = 0.0;    // device: atlas_sample (+ atlas_dilate when asked)
   double execute = 0.0;   // host wall time of the graph's submission, all passes
   double readback = 0.0;  // host: values (and atlas) out of mapped memory
@@ -61,14 +65,22 @@ struct DiffuseTimings {
 };
 
 // The blur's plan, on the host: three box radii per chart (texels) whose cascade has the
-// Gaussian's variance, and the work the six passes do. Independent of any device. With sigma in
+// Gaussian's variance, and the work its passes do. Independent of any device. With sigma in
 // model units and `mean_edge` > 0 (the mesh's mean edge length), the variance the linear
 // interpolation over triangles contributes (mean edge² / 4 per axis, see diffuse.cpp) is taken off the blur's.
 struct BlurPlan {
   std::vector<std::array<std::uint32_t, 3>> radii;  // per chart
-  std::uint32_t dispatches = 0;    // compute dispatches of the blur (always 6)
-  std::uint64_t line_jobs = 0;     // rows + columns, each pass
-  std::uint64_t texel_reads = 0;   // over the six passes: every texel twice per pass + window warm-up
+  // Per chart, rows then columns: blurred by the fused shader (the three boxes of an axis in one
+  // dispatch) rather than the cascade (one dispatch per box). Fused: lines up to
+  // passes::kShortLine texels (whole in private memory, any radius), and longer lines whose radii
+  // fit the rings (kFusedMaxRadius) and whose walk's overrun past the line (r1 + r2, a wrapping
+  // row 2 (r0 + r1 + r2)) is at most half the line, since a streamed step costs about two cascade
+  // steps. Never with DiffuseOptions::fused_blur off.
+  std::vector<std::array<bool, 2>> fused;
+  std::uint64_t fused_lines = 0, cascade_lines = 0;
+  std::uint32_t dispatches = 0;    // compute dispatches of the blur: per axis 1 fused + 3 cascade, when used
+  std::uint64_t line_jobs = 0;     // rows + columns
+  std::uint64_t texel_reads = 0;   // texels read from storage: fused once per walk, cascade twice per box + warm-up
 };
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge = 0.0f);
 

@@ -1,0 +1,21 @@
+#pragma once
+// Intrinsic heat diffusion of a per-vertex field on a triangle mesh: the reference the
+// texture-space diffusion and k-ring smoothing are measured against (issue 13, `sdfkit compare
+// --diffusion`, tests/diffusion). A Gaussian of sigma (model units) is heat flow for time
+// t = sigma² / 2; it is solved as `steps` implicit steps (M + (t / steps) L) u_{k+1} = M u_k with
+// L the cotangent Laplacian (positive semi-definite) and M the lumped (barycentric) mass, by a
+// sparse Cholesky factorization (Eigen). One step is the resolvent (1 + t Δ)^-1, whose kernel has
+// the Gaussian's variance but a sharper peak and heavier tails; more steps converge to heat flow.
+
+#include "sdfkit/core/mesh.hpp"
+
+#include <span>
+#include <vector>
+
+namespace sdfkit::diffusion {
+
+// One finite value per vertex, sigma > 0, steps >= 1; throws InputError otherwise. Degenerate
+// (zero-area) triangles are skipped; a vertex that no triangle with area touches keeps its value.
+std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> values, double sigma, int steps = 8);
+
+}  // namespace sdfkit::diffusion
