@@ -12,7 +12,7 @@
 //    texture space is no further from heat than k-ring).
 // The field: a smooth wave over the bounding box plus seeded noise (the camel test's field).
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--atlas-size N] MESH...
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -21,6 +21,8 @@
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/post/compare.hpp"
 #include "sdfkit/post/smooth.hpp"
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/skeleton/models.hpp"
 #include "sdfkit/skeleton/skeleton.hpp"
 #include "sdfkit/vulkan/context.hpp"
 
@@ -31,6 +33,8 @@
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <utility>
 #include <random>
 
 using namespace sdfkit;
@@ -57,12 +61,18 @@ int main(int argc, char** argv) {
   std::vector<float> sigmas;
   bool no_band = false;
   std::uint32_t atlas_size = 2048;
-  app.add_option("meshes", meshes, "Mesh files (closed)")->required()->check(CLI::ExistingFile);
+  bool models = false;
+  app.add_option("meshes", meshes, "Mesh files (closed)")->check(CLI::ExistingFile);
+  app.add_flag("--models", models, "Also generated shapes: capsule, torus, the skeleton models (star, genus 2, C and S plates)");
   std::string sigma_list = "1,2,3,5";
   app.add_option("--sigmas", sigma_list, "Sigmas in mean edge lengths, comma separated");
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
   app.add_option("--atlas-size", atlas_size, "Atlas size in texels")->check(CLI::Range(16, 16384));
   CLI11_PARSE(app, argc, argv);
+  if (meshes.empty() && !models) {
+    std::fprintf(stderr, "error: give mesh files or --models\n");
+    return 2;
+  }
   for (std::size_t at = 0; at <= sigma_list.size();) {
     const std::size_t end = std::min(sigma_list.find(',', at), sigma_list.size());
     const std::string item = sigma_list.substr(at, end - at);
@@ -83,13 +93,24 @@ int main(int argc, char** argv) {
                 atlas_size, no_band ? "none" : "3 sigma");
     std::printf("| mesh | vertices | sigma (edges) | charts | atlas triangles / faces | seam ratio (heat) | pearson | median rel | "
                 "rms | k-ring (k) rms | tex/k | overlap | build_stm s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for (const std::string& path : meshes) {
+    std::vector<std::pair<std::string, std::function<Mesh()>>> inputs;
+    for (const std::string& path : meshes)
+      inputs.emplace_back(std::filesystem::path(path).stem().string(), [path] { return io::load_asset(path).mesh; });
+    if (models) {
+      namespace sm = skeleton::models;
+      inputs.emplace_back("capsule", [] { return shapes::capsule(0.5f, 3.0f, 48, 40); });
+      inputs.emplace_back("torus", [] { return shapes::torus(1.0f, 0.3f, 96, 32); });
+      inputs.emplace_back("star", [] { return sm::five_armed_star().mesh; });
+      inputs.emplace_back("genus2", [] { return sm::genus2().mesh; });
+      inputs.emplace_back("c_plate", [] { return sm::c_shape().mesh; });
+      inputs.emplace_back("s_plate", [] { return sm::s_shape().mesh; });
+    }
+    for (const auto& [name, make] : inputs) {
       try {
-        const Mesh m = io::load_asset(path).mesh;
+        const Mesh m = make();
         const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
         const std::vector<float> u = wave_field(m);
         const float edge = mean_edge_length(m);
-        const std::string name = std::filesystem::path(path).stem().string();
         for (float edges : sigmas) {
           const float sigma = edges * edge;
           diffusion::StmOptions so;
@@ -120,7 +141,7 @@ int main(int argc, char** argv) {
           std::fflush(stdout);
         }
       } catch (const Error& e) {
-        std::printf("| %s | error: %s |\n", path.c_str(), e.what());
+        std::printf("| %s | error: %s |\n", name.c_str(), e.what());
       }
     }
   } catch (const Error& e) {
