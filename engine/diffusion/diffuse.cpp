@@ -12,6 +12,8 @@
 #include "sdfkit/vulkan/context.hpp"
 #include "sdfkit/vulkan/memory.hpp"
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -60,16 +62,19 @@ vk::Buffer make_buffer(vk::Context& ctx, std::size_t bytes, VkBufferUsageFlags u
   return vk::create_buffer(ctx, std::max<std::size_t>(bytes, 16), usage, use);
 }
 
-// The blur's sigma in a chart's texels. With sigma in model units, the variance the linear
-// interpolation over the triangles already contributes is taken off, so that blur ∘ interpolation
-// has the Gaussian's variance: a 1D hat of half-width h has h² / 6; over triangles whose mean edge
-// (diagonals included) is h we take h² / 4 per axis, the value that matched heat diffusion best on
-// the isometric cylinder of tests/diffusion (h² / 6 left sigma = 1 edge 10 % further from it).
-float sigma_px_of(const Chart& chart, const DiffuseOptions& o, float mean_edge) {
+// The blur's sigma in a chart's texels. With sigma in model units, the variance the rest of the
+// road adds is taken off, so that the whole has the Gaussian's variance sigma² per axis: the
+// linear interpolation over the triangles (interpolation_variance, derived in diffuse.hpp) and
+// the bilinear read-back at the vertex (weights 1 - f and f at distances f and 1 - f texels from
+// it: variance f (1 - f), 1/6 texel² over f uniform in [0, 1)). The rasterization point-samples the
+// interpolant at texel centres (no spread of its own) and the box cascade's variance is the
+// blur's. Tested on a flat grid with a quadratic field, whose Gaussian blur adds exactly twice
+// the variance per axis (diffuse_test: the pipeline's total variance is the requested one).
+float sigma_px_of(const Chart& chart, const DiffuseOptions& o, double interp_variance) {
   if (o.radius_px > 0.0f) return o.radius_px;
-  const double s = static_cast<double>(o.sigma) * chart.texels_per_unit;
-  const double h = static_cast<double>(mean_edge) * chart.texels_per_unit;
-  return static_cast<float>(std::sqrt(std::max(s * s - h * h / 4.0, 0.0)));
+  const double tpu = chart.texels_per_unit;
+  const double s = static_cast<double>(o.sigma) * tpu;
+  return static_cast<float>(std::sqrt(std::max(s * s - interp_variance * tpu * tpu - 1.0 / 6.0, 0.0)));
 }
 
 void check_options(const DiffuseOptions& o) {
@@ -97,12 +102,24 @@ std::array<std::uint32_t, 3> box_radii(float sigma_px) {
   return r;
 }
 
-BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge) {
+double interpolation_variance(const Mesh& mesh) {
+  double area = 0.0, sum = 0.0;
+  for (const Triangle& t : mesh.triangles) {
+    const glm::dvec3 a(mesh.positions[t[0]]), b(mesh.positions[t[1]]), c(mesh.positions[t[2]]);
+    const double ar = 0.5 * glm::length(glm::cross(b - a, c - a));
+    const double e2 = glm::dot(b - a, b - a) + glm::dot(c - b, c - b) + glm::dot(a - c, a - c);
+    area += ar;
+    sum += ar * e2 / 24.0;
+  }
+  return area > 0.0 ? sum / area : 0.0;
+}
+
+BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, double interp_variance) {
   check_options(options);
   BlurPlan plan;
   bool axis_fused[2] = {false, false}, axis_cascade[2] = {false, false};
   for (const Chart& c : mapping.charts) {
-    auto r = box_radii(sigma_px_of(c, options, mean_edge));
+    auto r = box_radii(sigma_px_of(c, options, interp_variance));
     // A periodic box no wider than the period (the shader wraps an index once at most).
     if (c.wraps_x)
       for (std::uint32_t& x : r) x = std::min(x, c.width > 1 ? (c.width - 1) / 2 : 0u);
@@ -221,7 +238,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     throw DeviceError("a " + std::to_string(size) + "² atlas is larger than the device allows");
 
   DiffuseResult result;
-  result.plan = plan_blur(mapping, options, options.sigma > 0.0f ? mean_edge_length(mesh) : 0.0f);
+  result.plan = plan_blur(mapping, options, options.sigma > 0.0f ? interpolation_variance(mesh) : 0.0);
 
   // Chart table.
   std::vector<passes::GpuChart> charts;

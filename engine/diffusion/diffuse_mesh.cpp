@@ -29,7 +29,22 @@ TextureSmoothResult smooth_texture_space(const Mesh& mesh, std::span<const float
   }
   r.skeleton_seconds = std::chrono::duration<double>(Clock::now() - t).count();
   t = Clock::now();
-  r.stm = build_stm(mesh, *skel, o.stm);
+  // The overlap band (StmOptions::overlap) the blur needs: kBandSigmas · σ along the surface.
+  // With σ in model units it is known before the mapping. With a radius in texels, σ in model
+  // units is radius / texels_per_unit, and the atlas scale falls as the bands grow: build without
+  // one, then with the band of the scale found (a quarter more, for the scale's fall), and again
+  // while the band is short of kBandSigmas · σ at the new scale (at most three more builds).
+  // A caller's own overlap (> 0) is kept.
+  StmOptions so = o.stm;
+  if (so.overlap == 0.0 && o.diffuse.sigma > 0.0f) so.overlap = kBandSigmas * o.diffuse.sigma;
+  r.stm = build_stm(mesh, *skel, so);
+  if (o.stm.overlap == 0.0 && o.diffuse.radius_px > 0.0f)
+    for (int round = 0; round < 3; ++round) {
+      const double need = kBandSigmas * o.diffuse.radius_px / r.stm.quality.texels_per_unit;
+      if (!(need > so.overlap)) break;
+      so.overlap = 1.25 * need;
+      r.stm = build_stm(mesh, *skel, so);
+    }
   r.mapping_seconds = std::chrono::duration<double>(Clock::now() - t).count();
   vk::ContextConfig config;
   config.device = o.device;

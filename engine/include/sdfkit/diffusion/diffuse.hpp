@@ -66,8 +66,9 @@ struct DiffuseTimings {
 
 // The blur's plan, on the host: three box radii per chart (texels) whose cascade has the
 // Gaussian's variance, and the work its passes do. Independent of any device. With sigma in
-// model units and `mean_edge` > 0 (the mesh's mean edge length), the variance the linear
-// interpolation over triangles contributes (mean edge² / 4 per axis, see diffuse.cpp) is taken off the blur's.
+// model units, what the road around the blur adds to the variance is taken off the blur's, so that
+// the whole has sigma²: `interpolation_variance` (model units², per axis: interpolation_variance()
+// of the mesh) and the bilinear sample-back's 1/6 texel² per axis.
 struct BlurPlan {
   std::vector<std::array<std::uint32_t, 3>> radii;  // per chart
   // Per chart, rows then columns: blurred by the fused shader (the three boxes of an axis in one
@@ -82,7 +83,18 @@ struct BlurPlan {
   std::uint64_t line_jobs = 0;     // rows + columns
   std::uint64_t texel_reads = 0;   // texels read from storage: fused once per walk, cascade twice per box + warm-up
 };
-BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, float mean_edge = 0.0f);
+BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, double interpolation_variance = 0.0);
+
+// The variance per axis (model units²) that rasterizing a per-vertex field linearly over the
+// triangles adds to whatever kernel then reads it at the vertices. The field read back at vertex
+// v is sum_j u_j w_j, w_j = ∫ K(x - v) φ_j(x) dx with φ_j the hat of vertex j; the kernel's second
+// moment about v is ∫ K(x - v) sum_j φ_j(x) |x_j - v|² dx, and sum_j φ_j(x) |x_j - v|² =
+// |x - v|² + sum_j φ_j(x) |x_j - x|² (the interpolant of a quadratic; the cross term vanishes as
+// sum_j φ_j(x) (x_j - x) = 0). So interpolation adds the mean of E(x) = sum_j φ_j(x) |x_j - x|²,
+// which over a triangle is sum of its squared edges / 12 (both axes; 1D: a hat of half-width h
+// adds h² / 6, the textbook value). Per axis of the surface, area-weighted over the triangles:
+// mean (|e0|² + |e1|² + |e2|²) / 24. Tested with a quadratic field on a flat grid (diffuse_test).
+double interpolation_variance(const Mesh& mesh);
 
 // Three box radii (texels) whose cascade has variance sigma_px² (within the rounding of integer
 // boxes: Kovesi's mix of two odd widths). sigma_px <= 0 gives {0, 0, 0}.

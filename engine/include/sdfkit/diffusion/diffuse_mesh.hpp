@@ -17,7 +17,7 @@ namespace sdfkit::diffusion {
 
 struct TextureSmoothOptions {
   DiffuseOptions diffuse;                       // radius_px or sigma (exactly one), keep_atlas, profile
-  StmOptions stm;                               // atlas size, gutter...
+  StmOptions stm;                               // atlas size, gutter; overlap 0: set from the blur (diffuse_mesh.cpp)
   const skeleton::Skeleton* skeleton = nullptr; // nullptr: skeleton::extract on the mesh, no SDF backend
   std::string device;                           // Vulkan device selector (empty: SDFKIT_VK_DEVICE or the best)
 };

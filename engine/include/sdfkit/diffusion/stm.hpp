@@ -52,7 +52,18 @@ struct StmOptions {
   // An atlas triangle whose longest edge is over this factor times its model length × the
   // atlas scale is stretched: its vertices in that chart move to a planar joint chart.
   double max_stretch = 3.0;
+  // Overlap band, model units (0: only the triangles that touch a chart, one ring). Each chart
+  // also carries the triangles within this distance along the surface (shortest edge paths)
+  // of its own vertices, parameterized by the chart's map, as far as that map neither flips nor
+  // stretches them (a fold ends the band there). A vertex is read back from its own chart only, so
+  // a blur of σ sees the neighbouring charts' surface up to the band: with the band at
+  // kBandSigmas · σ the diffusion has no seams. smooth_texture_space sets it from the blur's σ.
+  double overlap = 0.0;
 };
+
+// The overlap band a blur of standard deviation σ needs: a 2D Gaussian puts exp(-3²/2) = 1.1 %
+// of its weight beyond 3σ, so a band of 3σ cuts off at most that much of a border vertex's kernel.
+inline constexpr double kBandSigmas = 3.0;
 
 // Statistics of a distribution over the triangles of a chart, weighted by surface area.
 struct Stats {
@@ -88,6 +99,7 @@ struct StmQuality {
   double overlap = 0;
   // The same statistics over every chart's faces together (area weighted).
   Stats area_distortion, angle_distortion;
+  double band = 0;                 // the overlap band it was built with (StmOptions::overlap), model units
   double seconds = 0;              // wall-clock time of build_stm
 };
 
@@ -99,6 +111,7 @@ struct Stm {
 // Builds the mapping of `mesh` (V positions, F triangles; closed or not) from `skeleton` (its
 // nodes' `vertices` index mesh vertices: skeleton::extract on this mesh, or read_skeleton_json
 // of what `sdfkit skeleton` wrote for it). A vertex no node holds takes a neighbour's node.
+// With options.overlap > 0 the charts also carry their overlap bands (StmOptions::overlap).
 // Deterministic. Throws InputError for an empty mesh, a skeleton without nodes, a node vertex
 // out of range, or options out of range.
 Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skeleton, const StmOptions& options = {});

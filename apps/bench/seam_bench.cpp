@@ -1,0 +1,152 @@
+// sdfkit-seam-bench: seams and accuracy of texture-space diffusion through build_stm's atlas
+// (issue 13's validation) over many meshes. Per mesh (skeleton extracted from the geometry, no
+// SDF backend, as the tests do) and per sigma (in mean edge lengths): the mapping with the overlap
+// band of kBandSigmas · sigma (or none with --no-band), the diffusion on the Vulkan device, and
+//  - the seam ratio: P95 of |u_a - u_b| / |x_a - x_b| over edges whose ends are read back from
+//    different charts, over the same P95 for the edges inside charts (the issue's ≤ 1.5), and
+//    in brackets the same ratio of the heat-diffused field (what the field gives without seams);
+//  - against intrinsic heat diffusion (t = sigma² / 2, cotangent Laplacian, 8 implicit steps,
+//    Eigen: tests/diffusion/diffuse_test_util.hpp, shared with the tests): Pearson, median
+//    relative difference and RMS difference of the texture-space result, and the RMS of k-ring
+//    smoothing at the same sigma (kring_for_sigma); "tex/k" is the ratio of the two RMS (≤ 1: the
+//    texture space is no further from heat than k-ring).
+// The field: a smooth wave over the bounding box plus seeded noise (the camel test's field).
+//
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--atlas-size N] [--models] [MESH...]
+#include "../../tests/diffusion/diffuse_test_util.hpp"
+
+#include "sdfkit/core/error.hpp"
+#include "sdfkit/diffusion/diffuse.hpp"
+#include "sdfkit/diffusion/stm.hpp"
+#include "sdfkit/io/asset.hpp"
+#include "sdfkit/post/compare.hpp"
+#include "sdfkit/post/smooth.hpp"
+#include "sdfkit/core/shapes.hpp"
+#include "sdfkit/skeleton/models.hpp"
+#include "sdfkit/skeleton/skeleton.hpp"
+#include "sdfkit/vulkan/context.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <utility>
+#include <random>
+
+using namespace sdfkit;
+
+namespace {
+
+std::vector<float> wave_field(const Mesh& m) {
+  const Aabb box = bounding_box(m.positions);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.05f);
+  std::vector<float> u(m.vertex_count());
+  for (std::size_t v = 0; v < u.size(); ++v) {
+    const glm::vec3 p = (m.positions[v] - box.min) / box.diagonal();
+    u[v] = 1.0f + 0.5f * std::sin(6.0f * p.x) * std::cos(5.0f * p.y) + noise(rng);
+  }
+  return u;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
+  std::vector<std::string> meshes;
+  std::vector<float> sigmas;
+  bool no_band = false;
+  std::uint32_t atlas_size = 2048;
+  bool models = false;
+  app.add_option("meshes", meshes, "Mesh files (closed)")->check(CLI::ExistingFile);
+  app.add_flag("--models", models, "Also generated shapes: capsule, torus, the skeleton models (star, genus 2, C and S plates)");
+  std::string sigma_list = "1,2,3,5";
+  app.add_option("--sigmas", sigma_list, "Sigmas in mean edge lengths, comma separated");
+  app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
+  app.add_option("--atlas-size", atlas_size, "Atlas size in texels")->check(CLI::Range(16, 16384));
+  CLI11_PARSE(app, argc, argv);
+  if (meshes.empty() && !models) {
+    std::fprintf(stderr, "error: give mesh files or --models\n");
+    return 2;
+  }
+  for (std::size_t at = 0; at <= sigma_list.size();) {
+    const std::size_t end = std::min(sigma_list.find(',', at), sigma_list.size());
+    const std::string item = sigma_list.substr(at, end - at);
+    char* stop = nullptr;
+    const float x = std::strtof(item.c_str(), &stop);
+    if (item.empty() || *stop != '\0' || !(x > 0.0f) || !std::isfinite(x)) {
+      std::fprintf(stderr, "error: --sigmas: '%s' is not a positive number\n", item.c_str());
+      return 2;
+    }
+    sigmas.push_back(x);
+    at = end + 1;
+  }
+  try {
+    vk::Context ctx{vk::ContextConfig{}};
+    diffusion::Diffuser diffuser(ctx);
+    std::printf("atlas %u², band %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
+                "Against heat diffusion: texture Pearson / median rel. / RMS; k-ring RMS; tex/k = RMS ratio.\n\n",
+                atlas_size, no_band ? "none" : "3 sigma");
+    std::printf("| mesh | vertices | sigma (edges) | charts | atlas triangles / faces | seam ratio (heat) | pearson | median rel | "
+                "rms | k-ring (k) rms | tex/k | overlap | build_stm s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    std::vector<std::pair<std::string, std::function<Mesh()>>> inputs;
+    for (const std::string& path : meshes)
+      inputs.emplace_back(std::filesystem::path(path).stem().string(), [path] { return io::load_asset(path).mesh; });
+    if (models) {
+      namespace sm = skeleton::models;
+      inputs.emplace_back("capsule", [] { return shapes::capsule(0.5f, 3.0f, 48, 40); });
+      inputs.emplace_back("torus", [] { return shapes::torus(1.0f, 0.3f, 96, 32); });
+      inputs.emplace_back("star", [] { return sm::five_armed_star().mesh; });
+      inputs.emplace_back("genus2", [] { return sm::genus2().mesh; });
+      inputs.emplace_back("c_plate", [] { return sm::c_shape().mesh; });
+      inputs.emplace_back("s_plate", [] { return sm::s_shape().mesh; });
+    }
+    for (const auto& [name, make] : inputs) {
+      try {
+        const Mesh m = make();
+        const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
+        const std::vector<float> u = wave_field(m);
+        const float edge = mean_edge_length(m);
+        for (float edges : sigmas) {
+          const float sigma = edges * edge;
+          diffusion::StmOptions so;
+          so.atlas_size = atlas_size;
+          so.overlap = no_band ? 0.0 : diffusion::kBandSigmas * sigma;
+          const diffusion::Stm stm = diffusion::build_stm(m, skel, so);
+          diffusion::DiffuseOptions o;
+          o.sigma = sigma;
+          const std::vector<float> tex = diffuser.run(m, stm.mapping, u, o).values;
+          const test::SeamJumps s = test::seam_jumps(m, stm.mapping, tex);
+          const double ratio = s.border.empty() ? 0.0 : test::quantile(s.border, 0.95) / test::quantile(s.inside, 0.95);
+          const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
+          // The same statistic of the heat field over the same partition of the edges: what the
+          // field and where the borders lie give without any seam.
+          const test::SeamJumps hs = test::seam_jumps(m, stm.mapping, heat);
+          const double heat_ratio = hs.border.empty() ? 0.0 : test::quantile(hs.border, 0.95) / test::quantile(hs.inside, 0.95);
+          SmoothOptions ko;
+          ko.sigma = sigma;
+          ko.rings = diffusion::kring_for_sigma(sigma, edge);
+          const std::vector<float> kr = smooth_field(m, SdfDomain::Vertex, u, ko);
+          const FieldComparison c = compare_fields(tex, heat);
+          const double rms = test::rms_difference(tex, heat), krms = test::rms_difference(kr, heat);
+          std::printf("| %s | %zu | %g | %zu | %.2f | %.2f (%.2f) | %.4f | %.2f %% | %.4f | %.4f (%d) | %.2f | %.2f %% | %.2f |\n", name.c_str(),
+                      m.vertex_count(), static_cast<double>(edges), stm.mapping.charts.size(),
+                      static_cast<double>(stm.mapping.triangles.size()) / static_cast<double>(m.triangles.size()), ratio, heat_ratio,
+                      c.pearson, 100.0 * c.median_relative, rms, krms, ko.rings, krms > 0 ? rms / krms : 0.0, 100.0 * stm.quality.overlap,
+                      stm.quality.seconds);
+          std::fflush(stdout);
+        }
+      } catch (const Error& e) {
+        std::printf("| %s | error: %s |\n", name.c_str(), e.what());
+      }
+    }
+  } catch (const Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
