@@ -213,10 +213,13 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
     if (backend_stages.empty()) backend_stages.push_back({"sdf", compute_ms});
     sample("sdf");
   } else {
-    session.set_mesh(asset.mesh);
+    // The asset's mesh is lent to the session for the computation and taken back: one copy of
+    // the mesh in memory, shared by the asset, the session and the backend (not three).
+    session.set_mesh(std::move(out.asset.mesh));
     set_mesh_ms = clock.lap_ms();
     sample("set_mesh");
     out.field = session.compute(request.sdf);
+    out.asset.mesh = session.take_mesh();
     compute_ms = clock.lap_ms();
     sample("sdf");
     backend_stages = session.backend().last_timings();
