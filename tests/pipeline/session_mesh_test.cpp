@@ -1,7 +1,9 @@
 // One copy of the mesh (issue 15, memory at 13M triangles): a Session keeps the mesh it is given
 // and shares that object with its backend (set_shared_mesh) instead of copying it, and the
-// pipeline lends an asset's mesh to the session and takes the same buffers back. Checked by
-// buffer address with a recording backend, without a device.
+// pipeline moves an asset's mesh into the session. Checked by buffer address with a recording
+// backend, without a device; run_compute's files against write_field of the full asset.
+#include "scratch.hpp"
+
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/pipeline.hpp"
@@ -9,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <memory>
 
 using namespace sdfkit;
@@ -31,11 +35,16 @@ public:
     held.reset();
   }
   void update_positions(std::span<const glm::vec3> p) override { positions_moved = p.size(); }
+  // 1 everywhere, or with `distinct` each point's own value (its x + 2y + 3z + 10).
   RawSdf compute(const SdfQuery& q, const SdfOptions&) override {
-    return RawSdf{std::vector<float>(q.size(), 1.0f), std::vector<std::uint32_t>(q.size(), 1u)};
+    RawSdf raw{std::vector<float>(q.size(), 1.0f), std::vector<std::uint32_t>(q.size(), 1u)};
+    if (distinct)
+      for (std::size_t i = 0; i < q.size(); ++i) raw.values[i] = q.origins[i].x + 2 * q.origins[i].y + 3 * q.origins[i].z + 10;
+    return raw;
   }
 
   bool share = true;  // false: the default set_shared_mesh (a backend that copies)
+  bool distinct = false;
   int copies = 0, releases = 0;
   std::size_t positions_moved = 0;
   const Triangle* triangles_seen = nullptr;
@@ -97,21 +106,53 @@ TEST(SessionMesh, CopyingBackendKeepsWorking) {
   EXPECT_EQ(session.take_mesh().triangles.data(), triangles);
 }
 
-// The pipeline lends the asset's mesh to the session: the backend computes on the asset's own
-// buffers and the result's asset has them back (no copy on the way in or out).
-TEST(SessionMesh, PipelineLendsTheAssetsMesh) {
+// The pipeline moves the asset's mesh into the session: the backend computes on the asset's
+// own buffers, the session keeps them (a later compute uses them), and the result's asset gets
+// an equal mesh back after the computation.
+TEST(SessionMesh, PipelineMovesTheAssetsMeshIntoTheSession) {
   RecordingBackend* backend = nullptr;
   Session session = recording_session(backend);
   io::Asset asset = load_input("builtin:sphere");
   const Triangle* triangles = asset.mesh.triangles.data();
-  const std::size_t faces = asset.mesh.triangles.size();
+  const Mesh original = asset.mesh;
   ComputeRequest request;
   request.input = "builtin:sphere";
   const ComputeResult r = compute_asset(request, std::move(asset), [&]() -> Session& { return session; });
   EXPECT_EQ(backend->copies, 0);
   EXPECT_EQ(backend->triangles_seen, triangles);
-  EXPECT_EQ(r.asset.mesh.triangles.data(), triangles);
-  EXPECT_EQ(r.asset.mesh.triangles.size(), faces);
-  EXPECT_EQ(r.field.values.size(), r.asset.mesh.positions.size());
-  EXPECT_FALSE(backend->held);
+  ASSERT_TRUE(session.has_mesh());
+  EXPECT_EQ(session.mesh().triangles.data(), triangles);
+  EXPECT_EQ(backend->held.get(), &session.mesh());
+  EXPECT_EQ(r.asset.mesh.triangles, original.triangles);
+  EXPECT_EQ(r.asset.mesh.positions, original.positions);
+  EXPECT_EQ(r.field.values.size(), original.positions.size());
+}
+
+// run_compute writes PLY and txt from an asset without its input copy where welding merged
+// nothing (sphere), and from the full asset otherwise (tube, welded at its seams): either way
+// the file is byte for byte what write_field makes of the full asset.
+TEST(SessionMesh, RunComputeWritesWhatTheFullAssetWrites) {
+  const test::ScratchDir dir;
+  const auto bytes = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  for (const std::string shape : {"sphere", "tube"})
+    for (const std::string ext : {"ply", "txt"}) {
+      RecordingBackend* backend = nullptr;
+      Session session = recording_session(backend);
+      backend->distinct = true;
+      ComputeRequest request;
+      request.input = "builtin:" + shape;
+      request.output = dir.path(shape + "-run." + ext);
+      run_compute(request, session);
+      request.output.clear();
+      const ComputeResult full = compute_asset(request, [&]() -> Session& { return session; });
+      ASSERT_FALSE(full.asset.input_positions.empty());
+      const std::string expected = dir.path(shape + "-full." + ext);
+      io::write_field(expected, full.asset, full.field);
+      const std::string got = bytes(dir.path(shape + "-run." + ext));
+      EXPECT_GT(got.size(), 1000u) << shape << "." << ext;
+      EXPECT_EQ(got, bytes(expected)) << shape << "." << ext;
+    }
 }
