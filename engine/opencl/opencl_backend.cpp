@@ -107,10 +107,11 @@ constexpr std::size_t kCpuWorkGroup = 8;
 // Points per work item of trace_bundles (sdf_definition_shared.h).
 constexpr std::size_t kBundle = SDFKIT_BUNDLE_WIDTH;
 // Most points per batch on CPU devices, whose buffers are host memory beside the process's own:
-// 2^18 points at 30 rays are 70 MiB of batch buffers instead of the 512 MiB cap, and a batch
-// still traces for seconds on a 2-core CPU at that size, so the launches cost nothing. A
-// multiple of kBundle: the bundles are the same as in one batch.
-constexpr std::size_t kCpuBatchPoints = std::size_t{1} << 18;
+// 2^17 points at 30 rays are 35 MiB of batch buffers instead of the 512 MiB cap (2^18 held
+// another 35 MiB at the 13M-triangle run's peak), and a batch still traces for about a second
+// on a 2-core CPU at that size, so the launches cost nothing. A multiple of kBundle: the
+// bundles are the same as in one batch.
+constexpr std::size_t kCpuBatchPoints = std::size_t{1} << 17;
 
 std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m - 1) / m * m; }
 
