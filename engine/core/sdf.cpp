@@ -106,11 +106,14 @@ std::vector<float> normalized(std::span<const float> values) {
 
 SdfField compute_sdf(SdfBackend& backend, const Mesh& mesh, const SdfOptions& options) {
   validate_options(options);
-  const SdfQuery query = make_query(mesh, options.domain);
-  RawSdf raw = backend.compute(query, options);
-  if (raw.values.size() != query.size() || raw.kept_rays.size() != query.size())
-    throw Error("backend " + backend.name() + " returned " + std::to_string(raw.values.size()) +
-                " values for " + std::to_string(query.size()) + " points");
+  RawSdf raw;
+  {  // the query is freed before the field is finished
+    const SdfQuery query = make_query(mesh, options.domain);
+    raw = backend.compute(query, options);
+    if (raw.values.size() != query.size() || raw.kept_rays.size() != query.size())
+      throw Error("backend " + backend.name() + " returned " + std::to_string(raw.values.size()) +
+                  " values for " + std::to_string(query.size()) + " points");
+  }
   return finish_field(mesh, options.domain, std::move(raw));
 }
 

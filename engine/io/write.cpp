@@ -136,7 +136,8 @@ void put_color(std::string& s, float t) {
 
 }  // namespace
 
-void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values,
+void write_ply(std::ostream& out, std::span<const glm::vec3> positions, std::span<const Triangle> triangles,
+               const OutputValues& values,
                const WriteOptions& options) {
   const bool per_vertex = values.domain == SdfDomain::Vertex;
   const std::vector<float>& q = options.normalized ? values.normalized : values.raw;
@@ -147,10 +148,10 @@ void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values
   header += std::string("comment sdfkit shape diameter function, per ") +
             (per_vertex ? "vertex" : "face") +
             (options.normalized ? ", normalized to [0,1]" : ", model units") + "\n";
-  header += "element vertex " + std::to_string(asset.input_positions.size()) + "\n";
+  header += "element vertex " + std::to_string(positions.size()) + "\n";
   header += "property float x\nproperty float y\nproperty float z\n";
   if (per_vertex) header += "property float quality\n" + color_props;
-  header += "element face " + std::to_string(asset.input_triangles.size()) + "\n";
+  header += "element face " + std::to_string(triangles.size()) + "\n";
   header += "property list uchar int vertex_indices\n";
   if (!per_vertex) header += "property float quality\n" + color_props;
   header += "end_header\n";
@@ -166,9 +167,9 @@ void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values
     out.write(body.data(), static_cast<std::streamsize>(body.size()));
     body.clear();
   };
-  for (std::size_t v = 0; v < asset.input_positions.size(); ++v) {
+  for (std::size_t v = 0; v < positions.size(); ++v) {
     flush(false);
-    const glm::vec3& p = asset.input_positions[v];
+    const glm::vec3& p = positions[v];
     put_le(body, p.x);
     put_le(body, p.y);
     put_le(body, p.z);
@@ -177,10 +178,10 @@ void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values
       if (options.color) put_color(body, values.normalized[v]);
     }
   }
-  for (std::size_t f = 0; f < asset.input_triangles.size(); ++f) {
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
     flush(false);
     body += static_cast<char>(3);
-    for (const std::uint32_t i : asset.input_triangles[f])
+    for (const std::uint32_t i : triangles[f])
       put_le(body, static_cast<std::int32_t>(i));
     if (!per_vertex) {
       put_le(body, q[f]);
@@ -203,17 +204,31 @@ void check_output(const std::string& out_path, SdfDomain domain) {
 
 void write_field(const std::string& out_path, const Asset& asset, const SdfField& field,
                  const WriteOptions& options) {
+  write_field(out_path, asset, asset.mesh, field, options);
+}
+
+void write_field(const std::string& out_path, const Asset& asset, const Mesh& mesh, const SdfField& field,
+                 const WriteOptions& options) {
   check_output(out_path, field.domain);
   const Format format = format_from_path(out_path);
   const bool per_vertex = field.domain == SdfDomain::Vertex;
-  const std::size_t expected = per_vertex ? asset.mesh.vertex_count() : asset.mesh.face_count();
+  const std::size_t expected = per_vertex ? mesh.vertex_count() : mesh.face_count();
   if (field.values.size() != expected)
     throw InputError(out_path + ": the field has " + std::to_string(field.values.size()) +
                      " values but the mesh has " + std::to_string(expected) +
                      (per_vertex ? " vertices" : " faces"));
-  if (per_vertex && asset.input_to_welded.size() != asset.input_positions.size())
+  // An asset whose input is its own welded mesh: input_positions, input_triangles and
+  // input_to_welded all empty beside a mesh (what run_compute makes of an asset whose welding
+  // merged nothing, to hold one copy of the mesh instead of two). Written as PLY or txt only.
+  const bool input_is_mesh = asset.input_positions.empty() && asset.input_triangles.empty() &&
+                             asset.input_to_welded.empty() && !mesh.triangles.empty();
+  if (input_is_mesh && format != Format::Ply && format != Format::Txt)
+    throw Error(out_path + ": an asset without its input copy is written as .ply or .txt only");
+  const std::span<const glm::vec3> input_positions = input_is_mesh ? mesh.positions : asset.input_positions;
+  const std::span<const Triangle> input_triangles = input_is_mesh ? mesh.triangles : asset.input_triangles;
+  if (per_vertex && !input_is_mesh && asset.input_to_welded.size() != asset.input_positions.size())
     throw InputError(out_path + ": the asset's input-to-welded map does not match its vertices");
-  if (!per_vertex && asset.input_triangles.size() != asset.mesh.face_count())
+  if (!per_vertex && input_triangles.size() != mesh.face_count())
     throw InputError(out_path + ": the asset's input triangles do not match its mesh");
   if (!options.texcoord1.empty()) {
     if (format != Format::Gltf && format != Format::Glb)
@@ -234,7 +249,10 @@ void write_field(const std::string& out_path, const Asset& asset, const SdfField
   detail::OutputValues values;
   values.domain = field.domain;
   const std::vector<float> norm = normalized(field.values);
-  if (per_vertex) {
+  if (per_vertex && input_is_mesh) {
+    values.raw = field.values;
+    values.normalized = norm;
+  } else if (per_vertex) {
     values.raw.resize(asset.input_to_welded.size());
     values.normalized.resize(asset.input_to_welded.size());
     for (std::size_t i = 0; i < asset.input_to_welded.size(); ++i) {
@@ -253,7 +271,7 @@ void write_field(const std::string& out_path, const Asset& asset, const SdfField
   write_file_atomically(out_path, [&](std::ostream& out) {
     switch (format) {
       case Format::Txt: detail::write_txt(out, values, options.normalized); break;
-      case Format::Ply: detail::write_ply(out, asset, values, options); break;
+      case Format::Ply: detail::write_ply(out, input_positions, input_triangles, values, options); break;
       case Format::Gltf:
       case Format::Glb:
         detail::write_gltf(out, format == Format::Glb, asset, values, options, warnings);

@@ -6,6 +6,7 @@
 #include "sdfkit/io/asset.hpp"
 
 #include <iosfwd>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,10 @@ struct OutputValues {
 };
 
 void write_txt(std::ostream& out, const OutputValues& values, bool normalized);
-void write_ply(std::ostream& out, const Asset& asset, const OutputValues& values,
+// `positions` and `triangles`: the input's (asset.input_*), or the mesh where the asset's input
+// is its mesh (see write_field).
+void write_ply(std::ostream& out, std::span<const glm::vec3> positions, std::span<const Triangle> triangles,
+               const OutputValues& values,
                const WriteOptions& options);
 // Per-vertex values only. `binary` = .glb. Warnings (a replaced COLOR_0) go to `warnings`.
 void write_gltf(std::ostream& out, bool binary, const Asset& asset, const OutputValues& values,

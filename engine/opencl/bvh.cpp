@@ -331,7 +331,7 @@ struct Builder {
     std::vector<Top> top;
     std::vector<int> tasks;
     split_top(top, tasks, 0, n, 0, task_size, {});
-    std::vector<Subtree> parts(tasks.size());
+    std::vector<Subtree> parts(tasks.size());  // each freed once laid out below
     // Largest parts first.
     std::vector<std::size_t> schedule(tasks.size());
     for (std::size_t k = 0; k < schedule.size(); ++k) schedule[k] = k;
@@ -365,7 +365,7 @@ struct Builder {
       const Top& t = top[static_cast<std::size_t>(index)];
       out.depth = std::max(out.depth, t.depth);
       if (t.task >= 0) {
-        const Subtree& p = parts[static_cast<std::size_t>(t.task)];
+        Subtree& p = parts[static_cast<std::size_t>(t.task)];
         const auto offset = static_cast<std::uint32_t>(out.nodes.size());
         for (BvhNode node : p.nodes) {
           if (!node.is_leaf()) node.first_or_second += offset;
@@ -373,6 +373,7 @@ struct Builder {
         }
         out.depth = std::max(out.depth, p.depth);
         out.leaf_count += p.leaf_count;
+        p.nodes = std::vector<BvhNode>();  // one copy of the nodes at a time
         return;
       }
       const std::size_t at = out.nodes.size();
@@ -437,7 +438,7 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     }
     largest[slot++] = big;
   }, 1 << 16);
-  slot_of = {};
+  slot_of = std::vector<std::uint32_t>();  // frees it (`= {}` would keep the capacity)
   const glm::vec3 pad(1e-6f * *std::max_element(largest.begin(), largest.end()) + std::numeric_limits<float>::min());
   parallel_for(b.refs.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) b.refs[i].lo -= pad, b.refs[i].hi += pad;

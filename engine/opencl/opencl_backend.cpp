@@ -107,10 +107,11 @@ constexpr std::size_t kCpuWorkGroup = 8;
 // Points per work item of trace_bundles (sdf_definition_shared.h).
 constexpr std::size_t kBundle = SDFKIT_BUNDLE_WIDTH;
 // Most points per batch on CPU devices, whose buffers are host memory beside the process's own:
-// 2^18 points at 30 rays are 70 MiB of batch buffers instead of the 512 MiB cap, and a batch
-// still traces for seconds on a 2-core CPU at that size, so the launches cost nothing. A
-// multiple of kBundle: the bundles are the same as in one batch.
-constexpr std::size_t kCpuBatchPoints = std::size_t{1} << 18;
+// 2^17 points at 30 rays are 35 MiB of batch buffers instead of the 512 MiB cap (2^18 held
+// another 35 MiB at the 13M-triangle run's peak), and a batch still traces for about a second
+// on a 2-core CPU at that size, so the launches cost nothing. A multiple of kBundle: the
+// bundles are the same as in one batch.
+constexpr std::size_t kCpuBatchPoints = std::size_t{1} << 17;
 
 std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m - 1) / m * m; }
 
@@ -179,13 +180,15 @@ struct OpenClBackend::Impl {
   bool bundles = false;  // BVH traced by trace_bundles
   std::size_t local_size = 0;  // work-group size of the trace and gather kernels (0 = driver's)
 
-  // Geometry (resident between computes). The positions are kept only while the geometry is
-  // built (update_positions brings all of them again): the triangles are what a refit needs.
-  Mesh mesh;
-  std::size_t vertex_count = 0;
+  // Geometry (resident between computes). The host keeps no positions (update_positions brings
+  // all of them again), only the triangles a rebuild needs: the caller's shared mesh
+  // (set_shared_mesh) or a copy of its triangles (set_mesh).
+  std::shared_ptr<const Mesh> shape;
+  std::size_t vertex_count = 0, face_count = 0;
   bool has_mesh = false;
   Octree octree;
-  Bvh bvh;
+  Bvh bvh;  // nodes empty between a build and the next refit (see read_back_nodes)
+  std::size_t bvh_node_count = 0;
   double built_sah = 0.0;  // sah_cost of the last full build
   bool refitted = false;   // the last geometry update refit the BVH instead of building it
   detail::Buffer nodes, cells, tris;
@@ -203,7 +206,11 @@ struct OpenClBackend::Impl {
   void create(const OpenClConfig& cfg);
   void build_program();
   detail::Kernel make_kernel(const char* name);
-  void rebuild_geometry(bool positions_moved);
+  void rebuild_geometry(const Mesh& mesh, bool positions_moved);
+  void set_geometry(const Mesh& mesh, std::shared_ptr<const Mesh> keep);
+  // The BVH's nodes live in the device buffer only (no host copy beside it): read back for a
+  // refit or for bvh().
+  void read_back_nodes();
   void ensure_table(int rays, float cone_degrees);
   void write(cl_mem buffer, std::size_t bytes, const void* data, const char* what);
   void run(cl_kernel kernel, std::size_t items, std::size_t local, const char* name);
@@ -298,7 +305,7 @@ void OpenClBackend::Impl::run(cl_kernel kernel, std::size_t items, std::size_t l
 
 // Host: builds the octree and the per-face records; device: uploads them into buffers that
 // only grow, so moving vertices reuses the allocations.
-void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
+void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_moved) {
   auto start = std::chrono::steady_clock::now();
   // The triangle list of the leaves, leaf by leaf (octree: a triangle once per leaf it touches).
   const std::vector<std::uint32_t>* order = nullptr;
@@ -306,6 +313,7 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
   if (config.accel == Accel::Bvh) {
     // After update_positions: refit while the tree stays nearly as good as a fresh build (a
     // refused or too costly refit is replaced by the build below).
+    if (positions_moved && config.bvh_refit_limit > 0.0) read_back_nodes();
     refitted = positions_moved && config.bvh_refit_limit > 0.0 && !bvh.nodes.empty() &&
                refit_bvh(bvh, mesh) && sah_cost(bvh) <= config.bvh_refit_limit * built_sah;
     if (!refitted) {
@@ -330,6 +338,11 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
     cells.reserve(ctx, bytes_of(bvh.nodes), CL_MEM_READ_ONLY, "BVH nodes");
     nodes.reserve(ctx, 16, CL_MEM_READ_ONLY, "unused octree nodes");
     write(cells.get(), bytes_of(bvh.nodes), bvh.nodes.data(), "BVH nodes");
+    bvh_node_count = bvh.nodes.size();
+    // The device has the nodes: the host copy goes before the triangle records are mapped
+    // (read_back_nodes brings it back for a refit).
+    finish("uploading the BVH nodes");
+    bvh.nodes = std::vector<BvhNode>();
   } else {
     nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
     cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
@@ -366,6 +379,25 @@ void OpenClBackend::Impl::rebuild_geometry(bool positions_moved) {
   geometry_bytes = nodes.size() + cells.size() + tris.size();
 }
 
+void OpenClBackend::Impl::read_back_nodes() {
+  if (config.accel != Accel::Bvh || !bvh.nodes.empty() || bvh_node_count == 0) return;
+  bvh.nodes.resize(bvh_node_count);
+  check(clEnqueueReadBuffer(queue.get(), cells.get(), CL_TRUE, 0, bvh_node_count * sizeof(BvhNode),
+                            bvh.nodes.data(), 0, nullptr, nullptr),
+        "reading the BVH nodes back");
+}
+
+void OpenClBackend::Impl::set_geometry(const Mesh& mesh, std::shared_ptr<const Mesh> keep) {
+  validate_mesh(mesh, "the mesh given to the OpenCL backend");
+  has_mesh = false;
+  shape.reset();
+  vertex_count = mesh.positions.size();
+  face_count = mesh.triangles.size();
+  rebuild_geometry(mesh, false);
+  shape = std::move(keep);
+  has_mesh = true;
+}
+
 void OpenClBackend::Impl::ensure_table(int rays, float cone_degrees) {
   if (table.get() && table_rays == rays && table_cone == cone_degrees) return;
   // The rays of the C++ definition itself (local direction xyz, weight w), not a device copy of
@@ -394,21 +426,31 @@ std::string OpenClBackend::device_name() const {
 
 const DeviceInfo& OpenClBackend::device() const { return impl_->info; }
 const Octree& OpenClBackend::octree() const { return impl_->octree; }
-const Bvh& OpenClBackend::bvh() const { return impl_->bvh; }
+const Bvh& OpenClBackend::bvh() const {
+  impl_->read_back_nodes();
+  return impl_->bvh;
+}
 
 void OpenClBackend::set_mesh(const Mesh& mesh) {
-  validate_mesh(mesh, "the mesh given to the OpenCL backend");
-  impl_->has_mesh = false;
-  impl_->mesh.triangles = mesh.triangles;
-  impl_->mesh.positions = mesh.positions;
-  impl_->vertex_count = mesh.positions.size();
-  impl_->rebuild_geometry(false);
-  impl_->mesh.positions = {};
-  impl_->has_mesh = true;
+  // Built from the caller's mesh as it is; only the triangles are kept, for update_positions.
+  impl_->set_geometry(mesh, nullptr);
+  auto triangles = std::make_shared<Mesh>();
+  triangles->triangles = mesh.triangles;
+  impl_->shape = std::move(triangles);
 }
+
+void OpenClBackend::set_shared_mesh(std::shared_ptr<const Mesh> mesh) {
+  if (!mesh) throw Error("set_shared_mesh got no mesh");
+  const Mesh& m = *mesh;
+  impl_->set_geometry(m, std::move(mesh));
+}
+
+void OpenClBackend::release_mesh() { impl_->shape.reset(); }
 
 void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
   if (!impl_->has_mesh) throw Error("update_positions was called before set_mesh");
+  if (!impl_->shape || impl_->shape->triangles.size() != impl_->face_count)
+    throw Error("update_positions: the mesh was released (release_mesh); call set_mesh again");
   if (positions.size() != impl_->vertex_count)
     throw Error("update_positions got " + std::to_string(positions.size()) +
                 " positions for a mesh of " + std::to_string(impl_->vertex_count) +
@@ -416,9 +458,12 @@ void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
   for (const glm::vec3& p : positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw InputError("update_positions got a non-finite coordinate");
-  impl_->mesh.positions.assign(positions.begin(), positions.end());
-  impl_->rebuild_geometry(true);
-  impl_->mesh.positions = {};
+  // The rebuild reads positions and triangles as one Mesh: the triangles are copied for it and
+  // freed with it (update_positions is the skeleton's path, on small meshes).
+  Mesh moved;
+  moved.positions.assign(positions.begin(), positions.end());
+  moved.triangles = impl_->shape->triangles;
+  impl_->rebuild_geometry(moved, true);
 }
 
 std::size_t OpenClBackend::batch_points(int rays) const {
@@ -471,8 +516,10 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
   // One batch of points and normals at a time (not a second copy of the whole query): the
   // blocking writes wait for the previous batch's kernels, which read the same buffers.
   std::vector<glm::vec4> pts(batch), nrm(batch);
-  std::vector<float> values(n);
-  std::vector<std::uint32_t> kept(n);
+  // The results come back a batch at a time and go straight to their points (no second pair
+  // of per-point arrays in Morton order).
+  std::vector<float> values(batch);
+  std::vector<std::uint32_t> kept(batch);
   const cl_int rule = static_cast<cl_int>(options.false_hit);
   for (std::size_t first = 0; first < n; first += batch) {
     const std::size_t count = std::min(batch, n - first);
@@ -506,20 +553,18 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
              m.table.get(), m.values.get(), m.kept.get());
     m.run(m.k_gather.get(), count, m.local_size, "gather_points");
     check(clEnqueueReadBuffer(m.queue.get(), m.values.get(), CL_FALSE, 0, count * sizeof(float),
-                              &values[first], 0, nullptr, nullptr),
+                              values.data(), 0, nullptr, nullptr),
           "reading SDF values back");
-    check(clEnqueueReadBuffer(m.queue.get(), m.kept.get(), CL_FALSE, 0,
-                              count * sizeof(std::uint32_t), &kept[first], 0, nullptr,
-                              nullptr),
+    check(clEnqueueReadBuffer(m.queue.get(), m.kept.get(), CL_TRUE, 0,
+                              count * sizeof(std::uint32_t), kept.data(), 0, nullptr, nullptr),
           "reading kept-ray counts back");
-    // The host arrays of this batch stay alive until the finish below; the in-order queue
-    // makes the next batch's uploads wait for this batch's kernels.
+    // The in-order queue has run this batch's kernels and the first read: both reads are done.
+    for (std::size_t i = 0; i < count; ++i) {
+      raw.values[order[first + i]] = values[i];
+      raw.kept_rays[order[first + i]] = kept[i];
+    }
   }
   m.finish("tracing rays");
-  for (std::size_t i = 0; i < n; ++i) {
-    raw.values[order[i]] = values[i];
-    raw.kept_rays[order[i]] = kept[i];
-  }
   m.trace_ms = ms_since(start);
   return raw;
 }

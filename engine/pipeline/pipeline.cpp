@@ -168,8 +168,23 @@ void validate(const ComputeRequest& r) {
 
 namespace {
 
-// Validates, checks the output, and loads unless `preloaded`.
-ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, const SessionProvider& provider) {
+// Where welding merged nothing, the input vertices and triangles equal the welded mesh's.
+bool weld_is_identity(const io::Asset& a) {
+  if (a.input_to_welded.size() != a.mesh.positions.size() || a.input_triangles.size() != a.mesh.triangles.size())
+    return false;
+  for (std::uint32_t v = 0; v < a.input_to_welded.size(); ++v)
+    if (a.input_to_welded[v] != v) return false;
+  return a.input_positions == a.mesh.positions && a.input_triangles == a.mesh.triangles;
+}
+
+// Validates, checks the output, and loads unless `preloaded`. The asset's mesh moves into the
+// session (one copy, shared with the backend, which keeps it: Python's compute_file leaves the
+// session holding the file's mesh). `lean`: the caller only writes the result (run_compute),
+// so the asset does not get a copy of the mesh back (write_field takes the session's) and, as a
+// PLY or txt output needs no input copy where welding merged nothing, drops that copy before
+// the computation. At 13M triangles each copy is 230 MB at the peak.
+ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, const SessionProvider& provider,
+                           bool lean = false) {
   validate(request);
   ComputeResult out;
   ComputeReport& report = out.report;
@@ -205,6 +220,7 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
   report.solids = solids.solids.size();
   report.sdf_computations = solids.representatives.size();
   double set_mesh_ms = 0, compute_ms = 0;
+  const Mesh* mesh = &asset.mesh;  // the session's where the asset lent it
   std::vector<StageTiming> backend_stages;
   if (solids.solids.size() > 1) {
     out.field = compute_solids(session, asset, solids, request.sdf, backend_stages);
@@ -213,10 +229,21 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
     if (backend_stages.empty()) backend_stages.push_back({"sdf", compute_ms});
     sample("sdf");
   } else {
-    session.set_mesh(asset.mesh);
+    const bool ply_or_txt = request.output.empty() || io::format_from_path(request.output) == io::Format::Ply ||
+                            io::format_from_path(request.output) == io::Format::Txt;
+    if (lean && ply_or_txt && out.asset.format != io::Format::Gltf && out.asset.format != io::Format::Glb &&
+        weld_is_identity(out.asset)) {
+      out.asset.input_positions = std::vector<glm::vec3>();
+      out.asset.input_triangles = std::vector<Triangle>();
+      out.asset.input_to_welded = std::vector<std::uint32_t>();
+    }
+    session.set_mesh(std::move(out.asset.mesh));
     set_mesh_ms = clock.lap_ms();
     sample("set_mesh");
     out.field = session.compute(request.sdf);
+    // A copy for the result's asset, after the computation's peak; none when only writing.
+    if (!lean) out.asset.mesh = session.mesh();
+    mesh = &session.mesh();
     compute_ms = clock.lap_ms();
     sample("sdf");
     backend_stages = session.backend().last_timings();
@@ -238,7 +265,7 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
   if (request.smooth_rings > 0) {
     SmoothOptions smooth;
     smooth.rings = request.smooth_rings;
-    field.values = smooth_field(asset.mesh, field.domain, field.values, smooth);
+    field.values = smooth_field(*mesh, field.domain, field.values, smooth);
     report.stages.push_back({"smooth", clock.lap_ms()});
     sample("smooth");
   }
@@ -247,7 +274,7 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
     diffusion::TextureSmoothOptions t;
     t.diffuse.radius_px = request.smooth_texture_px;
     t.device = request.backend.device;
-    field.values = diffusion::smooth_texture_space(asset.mesh, field.values, t).values;
+    field.values = diffusion::smooth_texture_space(*mesh, field.values, t).values;
     report.stages.push_back({"smooth_texture", clock.lap_ms()});
     sample("smooth_texture");
   }
@@ -268,10 +295,13 @@ ComputeResult compute_asset(const ComputeRequest& request, io::Asset asset, cons
 
 ComputeReport run_compute(const ComputeRequest& request, const SessionProvider& provider) {
   Stopwatch clock;
-  ComputeResult r = compute_asset(request, provider);
+  // Only the report leaves: the asset is written with the session's mesh (compute_impl, lean).
+  Session* session = nullptr;
+  ComputeResult r = compute_impl(request, nullptr, [&]() -> Session& { return *(session = &provider()); }, true);
   if (!request.output.empty()) {
     clock.lap_ms();
-    io::write_field(request.output, r.asset, r.field, request.write);
+    const bool lent = r.asset.mesh.triangles.empty() && session != nullptr;
+    io::write_field(request.output, r.asset, lent ? session->mesh() : r.asset.mesh, r.field, request.write);
     r.report.stages.push_back({"write", clock.lap_ms()});
     r.report.memory.push_back({"write", resident_memory()});
   }

@@ -26,17 +26,27 @@ Session& Session::operator=(Session&&) noexcept = default;
 
 void Session::set_mesh(Mesh mesh) {
   has_mesh_ = false;
-  mesh_ = Mesh{};
-  backend_->set_mesh(mesh);
-  mesh_ = std::move(mesh);
+  backend_->release_mesh();
+  mesh_ = std::make_shared<Mesh>(std::move(mesh));
+  backend_->set_shared_mesh(mesh_);
   has_mesh_ = true;
+}
+
+Mesh Session::take_mesh() {
+  if (!has_mesh_) throw InputError("take_mesh: the session has no mesh");
+  has_mesh_ = false;
+  backend_->release_mesh();
+  // A backend that kept its reference after release_mesh gets a copy rather than a moved-from mesh.
+  Mesh out = mesh_.use_count() == 1 ? std::move(*mesh_) : *mesh_;
+  mesh_ = std::make_shared<Mesh>();
+  return out;
 }
 
 void Session::update_positions(std::span<const glm::vec3> positions) {
   if (!has_mesh_) throw InputError("update_positions: the session has no mesh; call set_mesh first");
-  if (positions.size() != mesh_.positions.size())
+  if (positions.size() != mesh_->positions.size())
     throw InputError("update_positions: got " + std::to_string(positions.size()) + " vertices, the mesh has " +
-                     std::to_string(mesh_.positions.size()) + " (use set_mesh to change the mesh)");
+                     std::to_string(mesh_->positions.size()) + " (use set_mesh to change the mesh)");
   for (std::size_t v = 0; v < positions.size(); ++v)
     if (!std::isfinite(positions[v].x) || !std::isfinite(positions[v].y) || !std::isfinite(positions[v].z))
       throw InputError("update_positions: vertex " + std::to_string(v) + " has a non-finite coordinate (NaN or Inf)");
@@ -44,16 +54,17 @@ void Session::update_positions(std::span<const glm::vec3> positions) {
     backend_->update_positions(positions);
   } catch (...) {
     has_mesh_ = false;  // the backend's geometry is in an unknown state
-    mesh_ = Mesh{};
+    backend_->release_mesh();
+    mesh_ = std::make_shared<Mesh>();
     throw;
   }
-  mesh_.positions.assign(positions.begin(), positions.end());
+  mesh_->positions.assign(positions.begin(), positions.end());
 }
 
 SdfField Session::compute(const SdfOptions& options) {
   if (!has_mesh_) throw InputError("compute: the session has no mesh; call set_mesh first");
   if (choice_.kind != BackendKind::Auto) check_backend_options(choice_.kind, BackendConfig{}, options);
-  return compute_sdf(*backend_, mesh_, options);
+  return compute_sdf(*backend_, *mesh_, options);
 }
 
 }  // namespace sdfkit

@@ -12,6 +12,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <memory>
 #include <filesystem>
 #include <string>
 
@@ -266,4 +268,45 @@ TEST(OpenClRobustness, NoPlatformGivesTheInstallSentence) {
   const std::string cmd = "SDFKIT_TEST_NO_PLATFORM_CHILD=1 OCL_ICD_VENDORS=/nonexistent-sdfkit-vendors '" +
                           self + "' --gtest_filter=OpenClRobustness.NoPlatformGivesTheInstallSentence >/dev/null 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+}
+
+// A shared mesh (what a Session gives) builds the same geometry as a lent one, the BVH's nodes
+// read back from the device are the tree that traces, a refit after set_shared_mesh reads them
+// back and matches a fresh build, and after release_mesh compute still works while
+// update_positions asks for a new set_mesh.
+TEST(OpenClRobustness, SharedMeshMatchesLentMeshAndCanBeReleased) {
+  SDFKIT_REQUIRE_CL(backend);
+  const Mesh base = shapes::capsule(1.0f, 3.0f, 40, 20);
+  const SdfQuery q = make_query(base, SdfDomain::Vertex);
+  backend.set_mesh(base);
+  const RawSdf lent = backend.compute(q, {});
+  const cl::Bvh lent_bvh = backend.bvh();
+  backend.set_shared_mesh(std::make_shared<const Mesh>(base));
+  const RawSdf shared = backend.compute(q, {});
+  EXPECT_EQ(lent.values, shared.values);
+  EXPECT_EQ(lent.kept_rays, shared.kept_rays);
+  const cl::Bvh& tree = backend.bvh();  // nodes read back from the device
+  ASSERT_FALSE(tree.nodes.empty());
+  ASSERT_EQ(tree.nodes.size(), lent_bvh.nodes.size());
+  EXPECT_EQ(0, std::memcmp(tree.nodes.data(), lent_bvh.nodes.data(), tree.nodes.size() * sizeof(cl::BvhNode)));
+  EXPECT_EQ(tree.order, lent_bvh.order);
+  EXPECT_DOUBLE_EQ(cl::sah_cost(tree), cl::sah_cost(cl::build_bvh(base, {16, 3.0f})));
+
+  Mesh nudged = base;
+  for (glm::vec3& p : nudged.positions) p = p * 1.02f + glm::vec3(0.01f * p.z, 0, 0);
+  backend.update_positions(nudged.positions);
+  EXPECT_EQ(backend.last_timings().front().stage, "bvh_refit");
+  const SdfQuery qn = make_query(nudged, SdfDomain::Vertex);
+  const RawSdf refit = backend.compute(qn, {});
+  backend.set_mesh(nudged);
+  const RawSdf fresh = backend.compute(qn, {});
+  EXPECT_EQ(refit.values, fresh.values);
+  EXPECT_EQ(refit.kept_rays, fresh.kept_rays);
+
+  backend.set_shared_mesh(std::make_shared<const Mesh>(base));
+  backend.release_mesh();
+  const RawSdf after = backend.compute(q, {});
+  EXPECT_EQ(after.values, lent.values);
+  EXPECT_THROW(backend.update_positions(base.positions), Error);
+  backend.set_mesh(base);  // leaves the shared backend as the other tests expect it
 }

@@ -31,13 +31,18 @@ public:
   // Which backend runs and why ("requested", "opencl on ...: no GPU, ...").
   const BackendChoice& choice() const { return choice_; }
 
-  // Uploads `mesh` (which must have passed validate_mesh) and keeps it.
+  // Uploads `mesh` (which must have passed validate_mesh) and keeps it: moved in, the one copy
+  // is shared with the backend (set_shared_mesh), not copied again.
   void set_mesh(Mesh mesh);
+  // Hands the session's mesh back to the caller without a copy (a caller done computing on a
+  // large mesh that needs it for something else). The session then holds no mesh (compute and
+  // update_positions need a set_mesh first); InputError without a mesh.
+  Mesh take_mesh();
   // Moves the vertices of the session's mesh (same count; InputError otherwise, or for a
   // non-finite coordinate). After a backend failure the session holds no mesh.
   void update_positions(std::span<const glm::vec3> positions);
   bool has_mesh() const { return has_mesh_; }
-  const Mesh& mesh() const { return mesh_; }
+  const Mesh& mesh() const { return *mesh_; }
 
   // The finished (filled) field of the session's mesh. Throws InputError without a mesh and
   // UsageError when `options` set what this backend would ignore (--rays on Vulkan).
@@ -46,7 +51,8 @@ public:
 private:
   BackendChoice choice_;  // before backend_: the constructor's make_backend fills it
   std::unique_ptr<SdfBackend> backend_;
-  Mesh mesh_;
+  // The session's mesh; the backend holds a const view of the same object (set_shared_mesh).
+  std::shared_ptr<Mesh> mesh_ = std::make_shared<Mesh>();
   bool has_mesh_ = false;
 };
 

@@ -91,6 +91,15 @@ public:
   virtual std::string device_name() const = 0;
   // Uploads geometry and builds whatever the backend needs; replaces earlier geometry.
   virtual void set_mesh(const Mesh& mesh) = 0;
+  // set_mesh for a mesh its owner shares instead of lending: the backend may keep `mesh` (what
+  // update_positions needs of it: the triangles) instead of a copy. The owner must not change
+  // the triangles while the backend holds it, and moves vertices only by also calling
+  // update_positions with the new positions. The default copies what set_mesh copies.
+  virtual void set_shared_mesh(std::shared_ptr<const Mesh> mesh) { set_mesh(*mesh); }
+  // Drops the backend's reference to a mesh of set_shared_mesh (the owner may then move it
+  // away): compute() keeps working on the uploaded geometry, update_positions needs a set_mesh
+  // first.
+  virtual void release_mesh() {}
   // Moves the vertices of the current mesh (same count, same triangles) and rebuilds derived
   // data; cheaper than set_mesh. Throws Error when the count differs.
   virtual void update_positions(std::span<const glm::vec3> positions) = 0;

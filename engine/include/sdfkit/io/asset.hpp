@@ -145,6 +145,12 @@ void check_output(const std::string& out_path, SdfDomain domain);
 // does not fit the asset or a per-face field to glTF, Error for an I/O failure.
 void write_field(const std::string& out_path, const Asset& asset, const SdfField& field,
                  const WriteOptions& options = {});
+// The same with `mesh` in place of asset.mesh: for an asset that lent its mesh to a Session
+// (run_compute). An asset whose input_positions, input_triangles and input_to_welded are all
+// empty has the mesh as its input (welding merged nothing and the copy was dropped): written as
+// .ply or .txt only.
+void write_field(const std::string& out_path, const Asset& asset, const Mesh& mesh, const SdfField& field,
+                 const WriteOptions& options = {});
 
 // The colour map of every sdfkit output: t in [0,1] (clamped; NaN counts as 0) to linear RGB in
 // [0,1]. A hue ramp at full saturation, as in the paper's figures: 0 = red (thin), 0.25 =

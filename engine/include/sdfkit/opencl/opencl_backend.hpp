@@ -90,6 +90,8 @@ public:
   std::string name() const override { return "opencl"; }
   std::string device_name() const override;
   void set_mesh(const Mesh& mesh) override;
+  void set_shared_mesh(std::shared_ptr<const Mesh> mesh) override;
+  void release_mesh() override;
   void update_positions(std::span<const glm::vec3> positions) override;
   RawSdf compute(const SdfQuery& query, const SdfOptions& options) override;
   // "octree_build" (or "bvh_build", "bvh_refit") and "upload" of the last set_mesh/update_positions,
@@ -101,7 +103,8 @@ public:
 
   const DeviceInfo& device() const;
   const Octree& octree() const;  // empty unless accel == Octree
-  const Bvh& bvh() const;        // empty unless accel == Bvh
+  // Empty unless accel == Bvh. The nodes live on the device only; this reads them back.
+  const Bvh& bvh() const;
   // Points per batch the memory cap allows for `rays` rays per point.
   std::size_t batch_points(int rays) const;
 
