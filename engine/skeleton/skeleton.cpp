@@ -994,6 +994,72 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
     for (const Triangle& t : original.triangles)
       for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
     for (const auto& e : mesh_edges) chi[mesh_parts.find(e[0])] -= 1;
+    // A sheet's own cycles (a band of sheet triangles around a hole) count against the genus:
+    // every closing curve edge below adds one independent cycle to those of the sheets (its
+    // ends are already joined), so a component keeps g minus its sheets' first Betti number.
+    // Where the sheets alone have more cycles than the genus, the holes are closed, shortest
+    // boundary loop first: a loop of boundary edges (edges of one sheet triangle) gets a fan of
+    // triangles from its first node when that lowers the sheets' Betti number.
+    std::map<std::uint32_t, std::size_t> sheet_cycles;
+    {
+      std::map<std::uint32_t, Skeleton> sheets_of;
+      for (const Triangle& t : sk.sheet_triangles)
+        for (std::uint32_t node : t)
+          if (!sk.nodes[node].vertices.empty()) {
+            sheets_of[mesh_parts.find(sk.nodes[node].vertices.front())].sheet_triangles.push_back(t);
+            break;
+          }
+      for (auto& [root, part] : sheets_of) {
+        part.nodes.resize(sk.nodes.size());
+        const auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+        auto betti = static_cast<std::size_t>(cycle_count(part));
+        if (betti > g) {
+          std::map<std::array<std::uint32_t, 2>, int> uses;
+          for (const Triangle& t : part.sheet_triangles)
+            for (int i = 0; i < 3; ++i) uses[{std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])}] += 1;
+          UnionFind tree(sk.nodes.size());
+          std::map<std::uint32_t, std::vector<std::uint32_t>> adjacency;
+          std::vector<std::array<std::uint32_t, 2>> closing_boundary;
+          for (const auto& [e, count] : uses) {
+            if (count != 1) continue;
+            if (tree.unite(e[0], e[1]))
+              adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+            else
+              closing_boundary.push_back(e);
+          }
+          // Each boundary edge that closes a cycle of the boundary forest gives one loop.
+          std::vector<std::pair<float, std::vector<std::uint32_t>>> loops;
+          for (const auto& e : closing_boundary) {
+            std::map<std::uint32_t, std::uint32_t> from{{e[0], e[0]}};
+            std::vector<std::uint32_t> queue{e[0]};
+            for (std::size_t q = 0; q < queue.size() && !from.count(e[1]); ++q)
+              for (std::uint32_t y : adjacency[queue[q]])
+                if (from.emplace(y, queue[q]).second) queue.push_back(y);
+            std::vector<std::uint32_t> loop{e[1]};
+            while (loop.back() != e[0]) loop.push_back(from[loop.back()]);
+            float length = glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position);
+            for (std::size_t i = 0; i + 1 < loop.size(); ++i)
+              length += glm::length(sk.nodes[loop[i]].position - sk.nodes[loop[i + 1]].position);
+            loops.push_back({length, std::move(loop)});
+          }
+          std::sort(loops.begin(), loops.end());
+          for (const auto& [length, loop] : loops) {
+            if (betti <= g) break;
+            const std::size_t before = part.sheet_triangles.size();
+            for (std::size_t i = 1; i + 1 < loop.size(); ++i) part.sheet_triangles.push_back({loop[0], loop[i], loop[i + 1]});
+            const auto now = static_cast<std::size_t>(cycle_count(part));
+            if (now < betti) {
+              sk.sheet_triangles.insert(sk.sheet_triangles.end(), part.sheet_triangles.begin() + static_cast<std::ptrdiff_t>(before),
+                                        part.sheet_triangles.end());
+              betti = now;
+            } else {
+              part.sheet_triangles.resize(before);
+            }
+          }
+        }
+        sheet_cycles[root] = betti;
+      }
+    }
     std::set<std::array<std::uint32_t, 2>> in_triangles;
     UnionFind forest(sk.nodes.size());
     for (const Triangle& t : sk.sheet_triangles) {
@@ -1014,9 +1080,84 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         closing[mesh_parts.find(sk.nodes[e[0]].vertices.front())].push_back(
             {through_air.count(e) ? -length : length, e});
     for (auto& [root, list] : closing) {
-      const auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+      auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+      if (const auto it = sheet_cycles.find(root); it != sheet_cycles.end()) g -= std::min(g, it->second);
       std::sort(list.rbegin(), list.rend());
       for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
+    }
+  }
+  // Terminal branches inside their junction's ball: a branch (a leaf and the chain of degree-2
+  // curve nodes up to the first node of degree >= 3) whose every node's ball lies inside the
+  // junction's ball describes no part of the solid that the junction's ball does not; it is a
+  // bump of the surface (a face's nose and chin, a knuckle), not a limb. Such branches are
+  // merged into their junction, the one with the deepest ball first, while the junction keeps
+  // degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
+  if (options.prune_branches) {
+    std::vector<std::uint8_t> dead(sk.nodes.size(), 0);
+    for (bool changed = true; changed;) {
+      changed = false;
+      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+      for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+      struct Branch {
+        float excess;  // max over the branch's nodes of |node - junction| + r_node - r_junction
+        std::uint32_t leaf, junction;
+        std::vector<std::uint32_t> path;
+      };
+      std::vector<Branch> branches;
+      for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
+        if (dead[leaf] || adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet) continue;
+        std::vector<std::uint32_t> path{leaf};
+        std::uint32_t prev = leaf, cur = adjacency[leaf].front();
+        while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
+          path.push_back(cur);
+          const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
+          prev = cur, cur = next;
+        }
+        if (adjacency[cur].size() < 3 || sk.nodes[cur].sheet) continue;
+        const Node& j = sk.nodes[cur];
+        float excess = -std::numeric_limits<float>::infinity();
+        for (std::uint32_t k : path)
+          excess = std::max(excess, glm::length(sk.nodes[k].position - j.position) + sk.nodes[k].radius - j.radius);
+        if (excess < 0.0f) branches.push_back({excess, leaf, cur, std::move(path)});
+      }
+      std::sort(branches.begin(), branches.end(), [](const Branch& a, const Branch& b) {
+        return a.excess != b.excess ? a.excess < b.excess : a.leaf < b.leaf;
+      });
+      std::vector<std::size_t> degree(sk.nodes.size());
+      for (std::uint32_t k = 0; k < sk.nodes.size(); ++k) degree[k] = adjacency[k].size();
+      for (const Branch& b : branches) {
+        if (degree[b.junction] < 3 || dead[b.leaf]) continue;
+        std::uint32_t prev = b.junction;
+        for (auto it = b.path.rbegin(); it != b.path.rend(); ++it) {
+          edges.erase({std::min(prev, *it), std::max(prev, *it)});
+          prev = *it;
+        }
+        --degree[b.junction];
+        Node& j = sk.nodes[b.junction];
+        for (std::uint32_t k : b.path) {
+          for (std::uint32_t v : sk.nodes[k].vertices) node_of_vertex[v] = b.junction;
+          j.vertices.insert(j.vertices.end(), sk.nodes[k].vertices.begin(), sk.nodes[k].vertices.end());
+          sk.nodes[k].vertices.clear();
+          dead[k] = 1;
+        }
+        std::sort(j.vertices.begin(), j.vertices.end());
+        changed = true;
+      }
+    }
+    // Remove the merged nodes and renumber.
+    if (std::find(dead.begin(), dead.end(), 1) != dead.end()) {
+      std::vector<std::uint32_t> index(sk.nodes.size(), UINT32_MAX);
+      std::vector<Node> kept;
+      for (std::uint32_t k = 0; k < sk.nodes.size(); ++k)
+        if (!dead[k]) index[k] = static_cast<std::uint32_t>(kept.size()), kept.push_back(std::move(sk.nodes[k]));
+      sk.nodes = std::move(kept);
+      std::set<std::array<std::uint32_t, 2>> renumbered;
+      for (const auto& e : edges) renumbered.insert({std::min(index[e[0]], index[e[1]]), std::max(index[e[0]], index[e[1]])});
+      edges = std::move(renumbered);
+      for (Triangle& t : sk.sheet_triangles)
+        for (std::uint32_t& v : t) v = index[v];
+      for (std::uint32_t& v : node_of_vertex)
+        if (v != UINT32_MAX) v = index[v];
     }
   }
   // Leaves reach the end of their limb: a curve leaf's node sits at the centre of its vertices'
