@@ -1144,7 +1144,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   // Terminal branches inside their junction's ball: a branch (a leaf and the chain of degree-2
   // curve nodes up to the first node of degree >= 3) whose every node's ball lies inside the
   // junction's ball describes no part of the solid that the junction's ball does not; it is a
-  // bump of the surface (a face's nose and chin, a knuckle), not a limb. Such branches are
+  // bump of the surface, not a limb. Such branches are
   // merged into their junction, the one with the deepest ball first, while the junction keeps
   // degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
   if (options.prune_branches) {
