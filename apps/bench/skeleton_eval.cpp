@@ -254,8 +254,9 @@ Eval run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend, bool sdf_
   if (const char* v = std::getenv("SDFKIT_EVAL_PROXY")) co.proxy_vertices = static_cast<std::size_t>(std::atol(v));
   try {
     const auto t0 = std::chrono::steady_clock::now();
-    sk::SkeletonOptions so;  // library defaults; SDFKIT_EVAL_EXTEND_LEAVES=0 for the comparison
+    sk::SkeletonOptions so;  // library defaults; SDFKIT_EVAL_EXTEND_LEAVES=0 / SDFKIT_EVAL_PRUNE_BRANCHES=0 for the comparisons
     if (const char* v = std::getenv("SDFKIT_EVAL_EXTEND_LEAVES")) so.extend_leaves = std::atoi(v) != 0;
+    if (const char* v = std::getenv("SDFKIT_EVAL_PRUNE_BRANCHES")) so.prune_branches = std::atoi(v) != 0;
     const sk::Skeleton s = sk::extract(mesh, &backend, co, so);
     const double seconds = seconds_since(t0);
     Eval e = measure(s, bvh);

@@ -21,6 +21,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
+#include <iterator>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
@@ -434,10 +436,19 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
       for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
       glm::vec3 p(mean / static_cast<double>(part.size()));
       if (!surface.bvh.inside(p)) {
-        std::uint32_t best = part.front();
-        for (std::uint32_t k : part)
-          if (glm::length(surface.centre[k] - p) < glm::length(surface.centre[best] - p)) best = k;
-        p = surface.centre[best];
+        // The nearest centre point inside the solid (a centre point can be outside where no
+        // inside point was found for its vertex: thin wings and fins); none of the 16 nearest:
+        // no node.
+        std::vector<std::pair<float, std::uint32_t>> by_distance;
+        for (std::uint32_t k : part) by_distance.push_back({glm::length(surface.centre[k] - p), k});
+        const std::size_t tried = std::min<std::size_t>(by_distance.size(), 16);
+        std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
+                          by_distance.end());
+        bool found = false;
+        for (std::size_t i = 0; i < tried && !found; ++i)
+          if (surface.bvh.inside(surface.centre[by_distance[i].second]))
+            p = surface.centre[by_distance[i].second], found = true;
+        if (!found) return false;
       }
       std::vector<std::uint32_t> seeing;
       for (std::uint32_t k : part)
@@ -854,11 +865,19 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         std::vector<std::vector<std::uint32_t>> vertex_nbrs(n);
         for (const Triangle& t : original.triangles)
           for (int i = 0; i < 3; ++i) vertex_nbrs[t[i]].push_back(t[(i + 1) % 3]), vertex_nbrs[t[(i + 1) % 3]].push_back(t[i]);
+        // A step between two centre points that does not cross the surface is inside only when
+        // the points are: a vertex whose centre point fell back to its contracted position (a
+        // thin wing where no inside point was found) could route the chain through the air.
+        std::vector<std::int8_t> centre_in(n, -1);
+        auto inside_centre = [&](std::uint32_t k) {
+          if (centre_in[k] < 0) centre_in[k] = surface.bvh.inside(surface.centre[k]) ? 1 : 0;
+          return centre_in[k] == 1;
+        };
         for (const auto& e : unrouted) {
           const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
           const glm::vec3 mid = 0.5f * (pa + pb);
           const float reach = glm::length(pb - pa);
-          auto near = [&](std::uint32_t k) { return glm::length(surface.centre[k] - mid) <= reach; };
+          auto near = [&](std::uint32_t k) { return glm::length(surface.centre[k] - mid) <= reach && inside_centre(k); };
           std::map<std::uint32_t, float> dist;
           std::map<std::uint32_t, std::uint32_t> from;
           using Item = std::pair<float, std::uint32_t>;
@@ -994,6 +1013,108 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
     for (const Triangle& t : original.triangles)
       for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
     for (const auto& e : mesh_edges) chi[mesh_parts.find(e[0])] -= 1;
+    // A sheet's own cycles (a band of sheet triangles around a hole) count against the genus:
+    // every closing curve edge below adds one independent cycle to those of the sheets (its
+    // ends are already joined), so a component keeps g minus its sheets' first Betti number.
+    // Where the sheets alone have more cycles than the genus, the holes are closed, shortest
+    // first: a fundamental cycle of the sheet edges that no set of sheet triangles bounds gets a
+    // fan of triangles from its first node (each fan removes exactly that cycle).
+    std::map<std::uint32_t, std::size_t> sheet_cycles;
+    {
+      std::map<std::uint32_t, Skeleton> sheets_of;
+      for (const Triangle& t : sk.sheet_triangles)
+        for (std::uint32_t node : t)
+          if (!sk.nodes[node].vertices.empty()) {
+            sheets_of[mesh_parts.find(sk.nodes[node].vertices.front())].sheet_triangles.push_back(t);
+            break;
+          }
+      for (auto& [root, part] : sheets_of) {
+        part.nodes.resize(sk.nodes.size());
+        const auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+        auto betti = static_cast<std::size_t>(cycle_count(part));
+        if (betti > g) {
+          // Fundamental cycles of a spanning forest of the sheet edges (shortest edges first)
+          // span every cycle of the sheets; one that is not a sum of triangle boundaries (its
+          // edge vector does not reduce to zero against the boundary columns, Z/2) is a hole.
+          std::map<std::array<std::uint32_t, 2>, std::uint32_t> edge_id;
+          for (const Triangle& t : part.sheet_triangles)
+            for (int i = 0; i < 3; ++i)
+              edge_id.emplace(std::array<std::uint32_t, 2>{std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])}, 0u);
+          std::uint32_t next_id = 0;
+          for (auto& [e, id] : edge_id) id = next_id++;
+          auto id_of = [&](std::uint32_t a, std::uint32_t b) { return edge_id.at({std::min(a, b), std::max(a, b)}); };
+          std::vector<std::vector<std::uint32_t>> columns;  // descending edge ids
+          std::map<std::uint32_t, std::size_t> pivot_of;
+          auto reduce = [&](std::vector<std::uint32_t> c) {
+            while (!c.empty()) {
+              const auto holder = pivot_of.find(c.front());
+              if (holder == pivot_of.end()) break;
+              std::vector<std::uint32_t> sum;
+              std::set_symmetric_difference(c.begin(), c.end(), columns[holder->second].begin(),
+                                            columns[holder->second].end(), std::back_inserter(sum), std::greater<>());
+              c = std::move(sum);
+            }
+            return c;
+          };
+          auto add_column = [&](std::vector<std::uint32_t> c) {
+            c = reduce(std::move(c));
+            if (c.empty()) return;
+            pivot_of.emplace(c.front(), columns.size());
+            columns.push_back(std::move(c));
+          };
+          for (const Triangle& t : part.sheet_triangles) {
+            std::vector<std::uint32_t> c{id_of(t[0], t[1]), id_of(t[1], t[2]), id_of(t[2], t[0])};
+            std::sort(c.begin(), c.end(), std::greater<>());
+            c.erase(std::unique(c.begin(), c.end()), c.end());
+            add_column(std::move(c));
+          }
+          std::vector<std::pair<float, std::array<std::uint32_t, 2>>> by_length;
+          for (const auto& [e, id] : edge_id)
+            by_length.push_back({glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position), e});
+          std::sort(by_length.begin(), by_length.end());
+          UnionFind tree(sk.nodes.size());
+          std::map<std::uint32_t, std::vector<std::uint32_t>> adjacency;
+          std::vector<std::array<std::uint32_t, 2>> non_tree;
+          for (const auto& [length, e] : by_length) {
+            if (tree.unite(e[0], e[1]))
+              adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+            else
+              non_tree.push_back(e);
+          }
+          std::vector<std::pair<float, std::vector<std::uint32_t>>> loops;
+          for (const auto& e : non_tree) {
+            std::map<std::uint32_t, std::uint32_t> from{{e[0], e[0]}};
+            std::vector<std::uint32_t> queue{e[0]};
+            for (std::size_t q = 0; q < queue.size() && !from.count(e[1]); ++q)
+              for (std::uint32_t y : adjacency[queue[q]])
+                if (from.emplace(y, queue[q]).second) queue.push_back(y);
+            std::vector<std::uint32_t> loop{e[1]};
+            while (loop.back() != e[0]) loop.push_back(from[loop.back()]);
+            float length = glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position);
+            for (std::size_t i = 0; i + 1 < loop.size(); ++i)
+              length += glm::length(sk.nodes[loop[i]].position - sk.nodes[loop[i + 1]].position);
+            loops.push_back({length, std::move(loop)});
+          }
+          std::sort(loops.begin(), loops.end());
+          // Shortest hole first: its loop gets a fan of triangles from its first node.
+          for (const auto& [length, loop] : loops) {
+            if (betti <= g) break;
+            std::vector<std::uint32_t> c;
+            for (std::size_t i = 0; i < loop.size(); ++i) c.push_back(id_of(loop[i], loop[(i + 1) % loop.size()]));
+            std::sort(c.begin(), c.end(), std::greater<>());
+            if (reduce(c).empty()) continue;  // bounds already
+            add_column(std::move(c));
+            for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+              part.sheet_triangles.push_back({loop[0], loop[i], loop[i + 1]});
+              sk.sheet_triangles.push_back({loop[0], loop[i], loop[i + 1]});
+            }
+            --betti;
+          }
+          betti = static_cast<std::size_t>(cycle_count(part));
+        }
+        sheet_cycles[root] = betti;
+      }
+    }
     std::set<std::array<std::uint32_t, 2>> in_triangles;
     UnionFind forest(sk.nodes.size());
     for (const Triangle& t : sk.sheet_triangles) {
@@ -1014,9 +1135,84 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
         closing[mesh_parts.find(sk.nodes[e[0]].vertices.front())].push_back(
             {through_air.count(e) ? -length : length, e});
     for (auto& [root, list] : closing) {
-      const auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+      auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+      if (const auto it = sheet_cycles.find(root); it != sheet_cycles.end()) g -= std::min(g, it->second);
       std::sort(list.rbegin(), list.rend());
       for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
+    }
+  }
+  // Terminal branches inside their junction's ball: a branch (a leaf and the chain of degree-2
+  // curve nodes up to the first node of degree >= 3) whose every node's ball lies inside the
+  // junction's ball describes no part of the solid that the junction's ball does not; it is a
+  // bump of the surface, not a limb. Such branches are
+  // merged into their junction, the one with the deepest ball first, while the junction keeps
+  // degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
+  if (options.prune_branches) {
+    std::vector<std::uint8_t> dead(sk.nodes.size(), 0);
+    for (bool changed = true; changed;) {
+      changed = false;
+      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+      for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+      struct Branch {
+        float excess;  // max over the branch's nodes of |node - junction| + r_node - r_junction
+        std::uint32_t leaf, junction;
+        std::vector<std::uint32_t> path;
+      };
+      std::vector<Branch> branches;
+      for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
+        if (dead[leaf] || adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet) continue;
+        std::vector<std::uint32_t> path{leaf};
+        std::uint32_t prev = leaf, cur = adjacency[leaf].front();
+        while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
+          path.push_back(cur);
+          const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
+          prev = cur, cur = next;
+        }
+        if (adjacency[cur].size() < 3 || sk.nodes[cur].sheet) continue;
+        const Node& j = sk.nodes[cur];
+        float excess = -std::numeric_limits<float>::infinity();
+        for (std::uint32_t k : path)
+          excess = std::max(excess, glm::length(sk.nodes[k].position - j.position) + sk.nodes[k].radius - j.radius);
+        if (excess < 0.0f) branches.push_back({excess, leaf, cur, std::move(path)});
+      }
+      std::sort(branches.begin(), branches.end(), [](const Branch& a, const Branch& b) {
+        return a.excess != b.excess ? a.excess < b.excess : a.leaf < b.leaf;
+      });
+      std::vector<std::size_t> degree(sk.nodes.size());
+      for (std::uint32_t k = 0; k < sk.nodes.size(); ++k) degree[k] = adjacency[k].size();
+      for (const Branch& b : branches) {
+        if (degree[b.junction] < 3 || dead[b.leaf]) continue;
+        std::uint32_t prev = b.junction;
+        for (auto it = b.path.rbegin(); it != b.path.rend(); ++it) {
+          edges.erase({std::min(prev, *it), std::max(prev, *it)});
+          prev = *it;
+        }
+        --degree[b.junction];
+        Node& j = sk.nodes[b.junction];
+        for (std::uint32_t k : b.path) {
+          for (std::uint32_t v : sk.nodes[k].vertices) node_of_vertex[v] = b.junction;
+          j.vertices.insert(j.vertices.end(), sk.nodes[k].vertices.begin(), sk.nodes[k].vertices.end());
+          sk.nodes[k].vertices.clear();
+          dead[k] = 1;
+        }
+        std::sort(j.vertices.begin(), j.vertices.end());
+        changed = true;
+      }
+    }
+    // Remove the merged nodes and renumber.
+    if (std::find(dead.begin(), dead.end(), 1) != dead.end()) {
+      std::vector<std::uint32_t> index(sk.nodes.size(), UINT32_MAX);
+      std::vector<Node> kept;
+      for (std::uint32_t k = 0; k < sk.nodes.size(); ++k)
+        if (!dead[k]) index[k] = static_cast<std::uint32_t>(kept.size()), kept.push_back(std::move(sk.nodes[k]));
+      sk.nodes = std::move(kept);
+      std::set<std::array<std::uint32_t, 2>> renumbered;
+      for (const auto& e : edges) renumbered.insert({std::min(index[e[0]], index[e[1]]), std::max(index[e[0]], index[e[1]])});
+      edges = std::move(renumbered);
+      for (Triangle& t : sk.sheet_triangles)
+        for (std::uint32_t& v : t) v = index[v];
+      for (std::uint32_t& v : node_of_vertex)
+        if (v != UINT32_MAX) v = index[v];
     }
   }
   // Leaves reach the end of their limb: a curve leaf's node sits at the centre of its vertices'

@@ -152,6 +152,10 @@ struct SkeletonOptions {
   // (when that lies over a node radius beyond the leaf, inside the solid): leaves reach the
   // ends of limbs instead of stopping at the centre of the last node's region.
   bool extend_leaves = true;
+  // Drop a terminal curve branch whose nodes' balls (centre, radius) all lie inside the ball of
+  // the node it hangs from: it adds nothing to the solid the skeleton's balls describe (a bump
+  // on the surface, not a limb); its vertices go to that node.
+  bool prune_branches = true;
 };
 
 struct Node {
