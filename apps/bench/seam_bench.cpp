@@ -39,21 +39,6 @@
 
 using namespace sdfkit;
 
-namespace {
-
-std::vector<float> wave_field(const Mesh& m) {
-  const Aabb box = bounding_box(m.positions);
-  std::mt19937 rng(5);
-  std::normal_distribution<float> noise(0.0f, 0.05f);
-  std::vector<float> u(m.vertex_count());
-  for (std::size_t v = 0; v < u.size(); ++v) {
-    const glm::vec3 p = (m.positions[v] - box.min) / box.diagonal();
-    u[v] = 1.0f + 0.5f * std::sin(6.0f * p.x) * std::cos(5.0f * p.y) + noise(rng);
-  }
-  return u;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
@@ -109,7 +94,7 @@ int main(int argc, char** argv) {
       try {
         const Mesh m = make();
         const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
-        const std::vector<float> u = wave_field(m);
+        const std::vector<float> u = test::wave_field(m);
         const float edge = mean_edge_length(m);
         for (float edges : sigmas) {
           const float sigma = edges * edge;

@@ -467,14 +467,7 @@ namespace {
 TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
   const Mesh m = io::load_asset(test::data_mesh("camel.off")).mesh;
   const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
-  const Aabb box = bounding_box(m.positions);
-  std::mt19937 rng(5);
-  std::normal_distribution<float> noise(0.0f, 0.05f);
-  std::vector<float> u(m.vertex_count());
-  for (std::size_t v = 0; v < u.size(); ++v) {
-    const glm::vec3 p = (m.positions[v] - box.min) / box.diagonal();
-    u[v] = 1.0f + 0.5f * std::sin(6.0f * p.x) * std::cos(5.0f * p.y) + noise(rng);
-  }
+  const std::vector<float> u = test::wave_field(m);
   const float edge = mean_edge_length(m);
   for (float edges : {1.0f, 2.0f, 3.0f, 5.0f}) {
     const float sigma = edges * edge;

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <set>
 #include <span>
 #include <utility>
@@ -166,6 +167,20 @@ inline double rms_difference(std::span<const float> a, std::span<const float> b)
   double s = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) s += (static_cast<double>(a[i]) - b[i]) * (static_cast<double>(a[i]) - b[i]);
   return std::sqrt(s / static_cast<double>(std::max<std::size_t>(a.size(), 1)));
+}
+
+// A smooth wave over the bounding box plus seeded Gaussian noise (σ 0.05): a field whose
+// diffusion the heat-agreement tests and sdfkit-seam-bench compare.
+inline std::vector<float> wave_field(const Mesh& m) {
+  const Aabb box = bounding_box(m.positions);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.05f);
+  std::vector<float> u(m.vertex_count());
+  for (std::size_t v = 0; v < u.size(); ++v) {
+    const glm::vec3 p = (m.positions[v] - box.min) / box.diagonal();
+    u[v] = 1.0f + 0.5f * std::sin(6.0f * p.x) * std::cos(5.0f * p.y) + noise(rng);
+  }
+  return u;
 }
 
 }  // namespace sdfkit::test
