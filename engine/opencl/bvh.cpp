@@ -10,8 +10,6 @@
 #include <array>
 #include <cmath>
 #include <atomic>
-#include <memory>
-#include <mutex>
 #include <thread>
 #include <limits>
 #include <string>
@@ -85,8 +83,7 @@ struct Subtree {
   std::size_t leaf_count = 0;
 };
 
-// Nodes with at least this many triangles bin on all threads where they have them (`many`: the
-// root, and on more than 2 threads the nodes above the concurrent halves; a pass over 1M refs is ~2 ms).
+// Nodes with at least this many triangles bin on all threads (a pass over 1M refs is ~2 ms).
 constexpr std::size_t kParallelBinning = 1 << 18;
 
 struct Bins {
@@ -100,14 +97,14 @@ struct Builder {
   std::vector<Ref> refs;
 
   // Bounds and centroid bounds of refs [begin, end).
-  void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds, bool many) const {
+  void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds) const {
     const auto pass = [&](std::size_t b, std::size_t e, Box& bb, Box& cb) {
       for (std::size_t i = b; i < e; ++i) {
         bb.grow(Box{refs[i].lo, refs[i].hi});
         cb.grow(refs[i].centroid());
       }
     };
-    if (!many || end - begin < kParallelBinning) return pass(begin, end, bounds, cbounds);
+    if (end - begin < kParallelBinning) return pass(begin, end, bounds, cbounds);
     std::vector<Box> bb(std::thread::hardware_concurrency() + 1), cb(bb.size());
     std::atomic<std::size_t> slot{0};
     parallel_for(end - begin, [&](std::size_t b, std::size_t e) {
@@ -119,7 +116,7 @@ struct Builder {
 
   // Bins refs [begin, end) by centroid on the three axes.
   void bin(std::size_t begin, std::size_t end, int bins, const Box& cbounds, const glm::vec3& scale,
-           Bins& out, bool many) const {
+           Bins& out) const {
     const auto pass = [&](std::size_t b, std::size_t e, Bins& r) {
       for (std::size_t i = b; i < e; ++i) {
         const Ref& ref = refs[i];
@@ -132,7 +129,7 @@ struct Builder {
         }
       }
     };
-    if (!many || end - begin < kParallelBinning) return pass(begin, end, out);
+    if (end - begin < kParallelBinning) return pass(begin, end, out);
     std::vector<Bins> partial(std::thread::hardware_concurrency() + 1);
     std::atomic<std::size_t> slot{0};
     parallel_for(end - begin, [&](std::size_t b, std::size_t e) { pass(begin + b, begin + e, partial[slot++]); },
@@ -179,86 +176,13 @@ struct Builder {
     }
   }
 
-  // partition_measured on all threads, with the same result: the serial partition swaps the
-  // k-th right-going triangle before the split point with the k-th left-going one from the end
-  // (counted backwards), and leaves every other triangle in place; here each chunk of the front
-  // part finds its first partner by the counts of the chunks before it, then does its swaps.
-  template <class Pred>
-  std::size_t partition_parallel(std::size_t begin, std::size_t end, Split& s, Pred left) {
-    const std::size_t n = end - begin;
-    const std::size_t chunks = std::min<std::size_t>(n, 4 * std::max(1u, std::thread::hardware_concurrency()));
-    const auto lo = [&](std::size_t from, std::size_t count, std::size_t c) { return from + count * c / chunks; };
-    // Sides, left counts and both sides' bounds, per chunk.
-    std::vector<std::uint8_t> goes_left(n);
-    std::vector<std::size_t> lefts(chunks, 0);
-    std::vector<std::array<Box, 4>> boxes(chunks);  // bounds and centroid bounds, left then right
-    parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
-      for (std::size_t c = cb; c < ce; ++c) {
-        std::array<Box, 4>& bx = boxes[c];
-        for (std::size_t i = lo(begin, n, c); i < lo(begin, n, c + 1); ++i) {
-          const Ref& r = refs[i];
-          const bool l = left(r);
-          goes_left[i - begin] = l;
-          lefts[c] += l;
-          bx[l ? 0 : 2].grow(Box{r.lo, r.hi});
-          bx[l ? 1 : 3].grow(r.centroid());
-        }
-      }
-    }, 1);
-    std::size_t mid = begin;
-    for (std::size_t c = 0; c < chunks; ++c) {
-      mid += lefts[c];
-      s.child_bounds[0].grow(boxes[c][0]);
-      s.child_cbounds[0].grow(boxes[c][1]);
-      s.child_bounds[1].grow(boxes[c][2]);
-      s.child_cbounds[1].grow(boxes[c][3]);
-    }
-    s.children_measured = true;
-    // Misplaced triangles: right-going ones in front chunks of [begin, mid), left-going ones
-    // in back chunks of [mid, end) (back chunk c counted from the end).
-    const std::size_t front = mid - begin, back = end - mid;
-    std::vector<std::size_t> front_before(chunks + 1, 0), back_before(chunks + 1, 0);
-    parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
-      for (std::size_t c = cb; c < ce; ++c) {
-        std::size_t f = 0, b = 0;
-        for (std::size_t i = lo(begin, front, c); i < lo(begin, front, c + 1); ++i) f += !goes_left[i - begin];
-        for (std::size_t i = lo(mid, back, chunks - 1 - c); i < lo(mid, back, chunks - c); ++i) b += goes_left[i - begin];
-        front_before[c + 1] = f;
-        back_before[c + 1] = b;
-      }
-    }, 1);
-    for (std::size_t c = 0; c < chunks; ++c) front_before[c + 1] += front_before[c], back_before[c + 1] += back_before[c];
-    parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
-      for (std::size_t c = cb; c < ce; ++c) {
-        const std::size_t k = front_before[c];
-        if (k == front_before[c + 1]) continue;
-        // The k-th (from 0) left-going triangle of the back part, counted from the end.
-        std::size_t j = 0;
-        while (back_before[j + 1] <= k) ++j;
-        std::size_t q = lo(mid, back, chunks - j);
-        for (std::size_t skip = k - back_before[j] + 1; skip > 0;) skip -= goes_left[--q - begin];
-        bool first = true;
-        for (std::size_t i = lo(begin, front, c); i < lo(begin, front, c + 1); ++i) {
-          if (goes_left[i - begin]) continue;
-          if (!first)
-            while (!goes_left[--q - begin]) {
-            }
-          first = false;
-          std::swap(refs[i], refs[q]);
-        }
-      }
-    }, 1);
-    return mid;
-  }
-
   // Bounds of refs [begin, end) and the split the SAH (or the object median) chooses; a split
   // partitions the range in place. Subtrees over disjoint ranges may be built concurrently.
-  // `many`: the node has all threads to itself (its passes over large ranges use them).
-  Split choose(std::size_t begin, std::size_t end, int depth, Known known = {}, bool many = false) {
+  Split choose(std::size_t begin, std::size_t end, int depth, Known known = {}) {
     Split s;
     Box cbounds;
     if (known.bounds) s.bounds = *known.bounds, cbounds = *known.cbounds;
-    else measure(begin, end, s.bounds, cbounds, many);
+    else measure(begin, end, s.bounds, cbounds);
     const std::size_t n = end - begin;
     if (n <= 1) return s;
     std::size_t mid = begin;
@@ -273,7 +197,7 @@ struct Builder {
       for (int axis = 0; axis < 3; ++axis)
         if (extent[axis] > 0.0f) scale[axis] = static_cast<float>(bins) / extent[axis];
       Bins binned;
-      bin(begin, end, bins, cbounds, scale, binned, many);
+      bin(begin, end, bins, cbounds, scale, binned);
       float best_cost = std::numeric_limits<float>::max();
       int best_axis = -1, best_split = 0;
       for (int axis = 0; axis < 3; ++axis) {
@@ -307,11 +231,9 @@ struct Builder {
       if (n <= static_cast<std::size_t>(params.leaf_size) && (best_axis < 0 || split_cost >= leaf_cost)) return s;
       if (best_axis >= 0) {
         const float sc = scale[best_axis], lo = cbounds.lo[best_axis];
-        const auto goes_left = [&](const Ref& r) {
+        mid = partition_measured(begin, end, s, [&](const Ref& r) {
           return std::min(bins - 1, static_cast<int>((r.centroid()[best_axis] - lo) * sc)) <= best_split;
-        };
-        mid = many && n >= params.parallel_partition_min ? partition_parallel(begin, end, s, goes_left)
-                                                         : partition_measured(begin, end, s, goes_left);
+        });
       }
     } else if (n <= static_cast<std::size_t>(params.leaf_size)) {
       return s;
@@ -359,46 +281,41 @@ struct Builder {
     ++t.leaf_count;
   }
 
-  // The top of the tree, split until every part holds at most `task_size` triangles; the
-  // parts become subtree tasks. A node given several threads (`spread`) bins and partitions on
-  // all of them and splits its two halves concurrently, each with its share of the threads;
-  // the tree is the same as a serial split's (the halves' triangle ranges are disjoint).
+  // The top of the tree, split on the calling thread (with parallel binning) until every part
+  // holds at most `task_size` triangles; the parts become subtree tasks.
   struct Top {
     Split split;
     std::size_t begin = 0, end = 0;
     int depth = 0;
-    std::unique_ptr<Top> child[2];  // internal
-    int task = -1;                  // a part built as a task
-    bool known = false;             // a task's bounds, measured by its parent's partition
+    int child[2] = {-1, -1};  // internal: Top indices
+    int task = -1;             // a part built as a task
+    bool known = false;        // a task's bounds, measured by its parent's partition
     Box bounds, cbounds;
   };
-  void split_top(Top& t, std::vector<Top*>& tasks, std::mutex& tasks_mutex, std::size_t task_size, Known known,
-                 unsigned spread) {
-    if (t.end - t.begin <= task_size) {
+  int split_top(std::vector<Top>& top, std::vector<int>& tasks, std::size_t begin, std::size_t end, int depth,
+                std::size_t task_size, Known known) {
+    const int index = static_cast<int>(top.size());
+    top.push_back({});
+    top[static_cast<std::size_t>(index)].begin = begin;
+    top[static_cast<std::size_t>(index)].end = end;
+    top[static_cast<std::size_t>(index)].depth = depth;
+    if (end - begin <= task_size) {
+      Top& t = top[static_cast<std::size_t>(index)];
+      t.task = static_cast<int>(tasks.size());
       if (known.bounds) t.known = true, t.bounds = *known.bounds, t.cbounds = *known.cbounds;
-      const std::lock_guard<std::mutex> lock(tasks_mutex);
-      tasks.push_back(&t);
-      return;
+      tasks.push_back(index);
+      return index;
     }
-    t.split = choose(t.begin, t.end, t.depth, known, spread > 1);
-    if (t.split.leaf) return;
-    for (int side = 0; side < 2; ++side) {
-      t.child[side] = std::make_unique<Top>();
-      t.child[side]->begin = side == 0 ? t.begin : t.split.mid;
-      t.child[side]->end = side == 0 ? t.split.mid : t.end;
-      t.child[side]->depth = t.depth + 1;
-    }
-    const auto half = [&](int side, unsigned threads) {
-      split_top(*t.child[side], tasks, tasks_mutex, task_size, child_known(t.split, side), threads);
-    };
-    if (spread < 2) {
-      half(0, 1);
-      half(1, 1);
-      return;
-    }
-    std::thread left([&] { half(0, spread / 2); });
-    half(1, spread - spread / 2);
-    left.join();
+    const Split s = choose(begin, end, depth, known);
+    top[static_cast<std::size_t>(index)].split = s;
+    if (s.leaf) return index;
+    const int l = split_top(top, tasks, begin, s.mid, depth + 1, task_size,
+                            child_known(s, 0));
+    const int r = split_top(top, tasks, s.mid, end, depth + 1, task_size,
+                            child_known(s, 1));
+    top[static_cast<std::size_t>(index)].child[0] = l;
+    top[static_cast<std::size_t>(index)].child[1] = r;
+    return index;
   }
 
   // The whole tree: the top split here, its parts built by all threads (each takes the next
@@ -411,23 +328,22 @@ struct Builder {
     const std::size_t task_size = n < kParallelBelow || threads == 1 ? n
                                   : n < (std::size_t{1} << 20)        ? (n + 1) / 2
                                                                       : n / (16 * threads);
-    Top root;
-    root.end = n;
-    std::vector<Top*> tasks;
-    std::mutex tasks_mutex;
-    split_top(root, tasks, tasks_mutex, task_size, {}, threads);
-    for (std::size_t k = 0; k < tasks.size(); ++k) tasks[k]->task = static_cast<int>(k);
+    std::vector<Top> top;
+    std::vector<int> tasks;
+    split_top(top, tasks, 0, n, 0, task_size, {});
     std::vector<Subtree> parts(tasks.size());  // each freed once laid out below
     // Largest parts first.
     std::vector<std::size_t> schedule(tasks.size());
     for (std::size_t k = 0; k < schedule.size(); ++k) schedule[k] = k;
     std::sort(schedule.begin(), schedule.end(), [&](std::size_t a, std::size_t b) {
-      return tasks[a]->end - tasks[a]->begin > tasks[b]->end - tasks[b]->begin;
+      const Top& ta = top[static_cast<std::size_t>(tasks[a])];
+      const Top& tb = top[static_cast<std::size_t>(tasks[b])];
+      return ta.end - ta.begin > tb.end - tb.begin;
     });
     std::atomic<std::size_t> next{0};
     const auto worker = [&] {
       for (std::size_t k; (k = next++) < schedule.size();) {
-        const Top& t = *tasks[schedule[k]];
+        const Top& t = top[static_cast<std::size_t>(tasks[schedule[k]])];
         Subtree& part = parts[schedule[k]];
         part.nodes.emplace_back();
         build(part, 0, t.begin, t.end, t.depth, t.known ? Known{&t.bounds, &t.cbounds} : Known{});
@@ -435,17 +351,18 @@ struct Builder {
     };
     {
       std::vector<std::thread> pool;
-      const std::size_t helpers = std::min<std::size_t>(threads, std::max<std::size_t>(tasks.size(), 1)) - 1;
+      const std::size_t helpers = std::min<std::size_t>(threads, tasks.size()) - 1;
       for (std::size_t k = 0; k < helpers; ++k) pool.emplace_back(worker);
       worker();
       for (std::thread& th : pool) th.join();
     }
 
     Bvh out;
-    std::size_t total = 2 * tasks.size() + 1;  // the top nodes, about
+    std::size_t total = top.size();
     for (const Subtree& p : parts) total += p.nodes.size();
     out.nodes.reserve(total);
-    const auto emit = [&](auto&& self, const Top& t) -> void {
+    const auto emit = [&](auto&& self, int index) -> void {
+      const Top& t = top[static_cast<std::size_t>(index)];
       out.depth = std::max(out.depth, t.depth);
       if (t.task >= 0) {
         Subtree& p = parts[static_cast<std::size_t>(t.task)];
@@ -468,11 +385,11 @@ struct Builder {
         ++out.leaf_count;
         return;
       }
-      self(self, *t.child[0]);
+      self(self, t.child[0]);
       out.nodes[at].first_or_second = static_cast<std::uint32_t>(out.nodes.size());
-      self(self, *t.child[1]);
+      self(self, t.child[1]);
     };
-    emit(emit, root);
+    emit(emit, 0);
     out.order.resize(n);
     parallel_for(n, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) out.order[i] = refs[i].face;

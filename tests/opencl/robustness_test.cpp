@@ -13,7 +13,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <limits>
 #include <memory>
 #include <filesystem>
 #include <string>
@@ -310,33 +309,4 @@ TEST(OpenClRobustness, SharedMeshMatchesLentMeshAndCanBeReleased) {
   EXPECT_EQ(after.values, lent.values);
   EXPECT_THROW(backend.update_positions(base.positions), Error);
   backend.set_mesh(base);  // leaves the shared backend as the other tests expect it
-}
-
-// The parallel partition of large nodes gives the tree of the serial one, node for node and
-// triangle for triangle: forced on every node of 2+ triangles (down to single-triangle chunks)
-// or 64+ against never, on meshes with many coincident centroid coordinates (sphere, box, torus) and
-// with several leaf sizes, and at the default threshold on a mesh over 2^20 triangles, whose
-// top nodes take it.
-TEST(OpenClRobustness, ParallelPartitionBuildsTheSerialTree) {
-  const auto same = [](const Mesh& mesh, cl::BvhParams params, std::size_t forced) {
-    params.parallel_partition_min = forced;
-    const cl::Bvh parallel = cl::build_bvh(mesh, params);
-    params.parallel_partition_min = std::numeric_limits<std::size_t>::max();
-    const cl::Bvh serial = cl::build_bvh(mesh, params);
-    ASSERT_EQ(parallel.nodes.size(), serial.nodes.size());
-    EXPECT_EQ(0, std::memcmp(parallel.nodes.data(), serial.nodes.data(), serial.nodes.size() * sizeof(cl::BvhNode)));
-    EXPECT_EQ(parallel.order, serial.order);
-    EXPECT_EQ(parallel.depth, serial.depth);
-    EXPECT_EQ(parallel.leaf_count, serial.leaf_count);
-  };
-  for (const cl::BvhParams params : {cl::BvhParams{1, 1.0f}, cl::BvhParams{4, 1.0f}, cl::BvhParams{16, 3.0f}}) {
-    same(shapes::icosphere(1.0f, 3), params, 2);
-    for (const Mesh& mesh : {shapes::icosphere(1.0f, 5), shapes::box(1.0f, 2.0f, 3.0f, 30), shapes::torus(2.0f, 0.5f, 90, 40)}) {
-      SCOPED_TRACE(mesh.triangles.size());
-      same(mesh, params, 64);
-    }
-  }
-  const Mesh big = shapes::icosphere(1.0f, 8);  // 1.3M triangles: 64 top parts
-  ASSERT_GT(big.triangles.size(), std::size_t{1} << 20);
-  same(big, {16, 3.0f}, cl::BvhParams{}.parallel_partition_min);
 }

@@ -18,7 +18,6 @@
 
 #include "sdfkit/core/mesh.hpp"
 
-#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -27,8 +26,6 @@ namespace sdfkit::cl {
 struct BvhParams {
   int leaf_size = 4;           // >= 1
   float traversal_cost = 1.0f;  // a node visit in triangle tests, > 0
-  // Nodes with at least this many triangles are partitioned on all threads (the same tree and triangle order as the serial partition; tests lower it).
-  std::size_t parallel_partition_min = std::size_t{1} << 18;
 };
 
 // One flattened node, as the device reads it (two float4: min + word, max + word).
