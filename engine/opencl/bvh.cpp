@@ -13,6 +13,9 @@
 #include <thread>
 #include <limits>
 #include <string>
+#include <memory>
+#include <type_traits>
+#include <utility>
 
 namespace sdfkit::cl {
 
@@ -49,10 +52,32 @@ struct Ref {
   glm::vec3 lo;
   std::uint32_t face;
   glm::vec3 hi;
-  std::uint32_t pad = 0;
+  std::uint32_t pad;  // 0, set by the fill
   glm::vec3 centroid() const { return (lo + hi) * 0.5f; }
 };
 static_assert(sizeof(Ref) == 32);
+static_assert(std::is_trivially_default_constructible_v<Ref>);
+
+// Leaves a vector's new elements uninitialized: the refs (32 bytes per triangle, 426 MB at 13M)
+// are first written by the parallel fill, not zeroed on one thread before it.
+template <class T>
+struct Uninitialized : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = Uninitialized<U>;
+  };
+  Uninitialized() = default;
+  template <class U>
+  Uninitialized(const Uninitialized<U>&) {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
 
 // Where a node's triangles go: a leaf, or two children split at `mid` (refs partitioned).
 struct Split {
@@ -94,7 +119,7 @@ struct Bins {
 
 struct Builder {
   BvhParams params;
-  std::vector<Ref> refs;
+  std::vector<Ref, Uninitialized<Ref>> refs;
 
   // Bounds and centroid bounds of refs [begin, end).
   void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds) const {
@@ -433,7 +458,7 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
       if (degenerate[f]) continue;
       Box box;
       for (std::uint32_t v : mesh.triangles[f]) box.grow(mesh.positions[v]);
-      b.refs[slot_of[f]] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi};
+      b.refs[slot_of[f]] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi, 0};
       big = std::max({big, glm::length(box.lo), glm::length(box.hi)});
     }
     largest[slot++] = big;
