@@ -32,16 +32,6 @@ void Session::set_mesh(Mesh mesh) {
   has_mesh_ = true;
 }
 
-Mesh Session::take_mesh() {
-  if (!has_mesh_) throw InputError("take_mesh: the session has no mesh");
-  has_mesh_ = false;
-  backend_->release_mesh();
-  // A backend that kept its reference after release_mesh gets a copy rather than a moved-from mesh.
-  Mesh out = mesh_.use_count() == 1 ? std::move(*mesh_) : *mesh_;
-  mesh_ = std::make_shared<Mesh>();
-  return out;
-}
-
 void Session::update_positions(std::span<const glm::vec3> positions) {
   if (!has_mesh_) throw InputError("update_positions: the session has no mesh; call set_mesh first");
   if (positions.size() != mesh_->positions.size())

@@ -4,7 +4,6 @@
 // backend, without a device; run_compute's files against write_field of the full asset.
 #include "scratch.hpp"
 
-#include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/pipeline.hpp"
 #include "sdfkit/session.hpp"
@@ -30,10 +29,7 @@ public:
     triangles_seen = m->triangles.data();
     held = std::move(m);
   }
-  void release_mesh() override {
-    ++releases;
-    held.reset();
-  }
+  void release_mesh() override { held.reset(); }
   void update_positions(std::span<const glm::vec3> p) override { positions_moved = p.size(); }
   // 1 everywhere, or with `distinct` each point's own value (its x + 2y + 3z + 10).
   RawSdf compute(const SdfQuery& q, const SdfOptions&) override {
@@ -45,7 +41,7 @@ public:
 
   bool share = true;  // false: the default set_shared_mesh (a backend that copies)
   bool distinct = false;
-  int copies = 0, releases = 0;
+  int copies = 0;
   std::size_t positions_moved = 0;
   const Triangle* triangles_seen = nullptr;
   std::shared_ptr<const Mesh> held;
@@ -79,20 +75,9 @@ TEST(SessionMesh, MovedInMeshIsSharedWithTheBackendNotCopied) {
   EXPECT_EQ(backend->positions_moved, moved.size());
   EXPECT_EQ(backend->held->positions, moved);
   EXPECT_EQ(backend->held->triangles.data(), triangles);
-
-  // take_mesh: the same buffers come back; the backend let go first; the session is empty.
-  const int releases = backend->releases;
-  const Mesh back = session.take_mesh();
-  EXPECT_GT(backend->releases, releases);
-  EXPECT_FALSE(backend->held);
-  EXPECT_EQ(back.triangles.data(), triangles);
-  EXPECT_FALSE(session.has_mesh());
-  EXPECT_THROW(session.compute({}), InputError);
-  EXPECT_THROW(session.take_mesh(), InputError);
 }
 
-// A backend that keeps its own copy (the default set_shared_mesh) still works, and take_mesh
-// still hands back the session's buffers.
+// A backend that keeps its own copy (the default set_shared_mesh) still works.
 TEST(SessionMesh, CopyingBackendKeepsWorking) {
   RecordingBackend* backend = nullptr;
   Session session = recording_session(backend, false);
@@ -103,7 +88,6 @@ TEST(SessionMesh, CopyingBackendKeepsWorking) {
   EXPECT_EQ(backend->triangles_seen, triangles);  // set_mesh(*shared): a view of the same mesh
   const SdfField f = session.compute({});
   EXPECT_EQ(f.values, std::vector<float>(session.mesh().positions.size(), 1.0f));
-  EXPECT_EQ(session.take_mesh().triangles.data(), triangles);
 }
 
 // The pipeline moves the asset's mesh into the session: the backend computes on the asset's

@@ -34,10 +34,6 @@ public:
   // Uploads `mesh` (which must have passed validate_mesh) and keeps it: moved in, the one copy
   // is shared with the backend (set_shared_mesh), not copied again.
   void set_mesh(Mesh mesh);
-  // Hands the session's mesh back to the caller without a copy (a caller done computing on a
-  // large mesh that needs it for something else). The session then holds no mesh (compute and
-  // update_positions need a set_mesh first); InputError without a mesh.
-  Mesh take_mesh();
   // Moves the vertices of the session's mesh (same count; InputError otherwise, or for a
   // non-finite coordinate). After a backend failure the session holds no mesh.
   void update_positions(std::span<const glm::vec3> positions);
