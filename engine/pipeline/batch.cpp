@@ -138,14 +138,6 @@ std::size_t remove_stale_temporaries(const std::string& dir, const std::vector<s
   return removed;
 }
 
-// Adds `stages` (not nested) to the running sums, keeping the order of first appearance.
-void accumulate(std::vector<StageTiming>& sums, const std::vector<StageTiming>& stages) {
-  for (const StageTiming& s : stages) {
-    auto it = std::find_if(sums.begin(), sums.end(), [&](const StageTiming& t) { return t.stage == s.stage; });
-    if (it == sums.end()) sums.push_back({s.stage, s.milliseconds, s.nested});
-    else it->milliseconds += s.milliseconds;
-  }
-}
 
 }  // namespace
 
@@ -334,7 +326,7 @@ BatchSummary run_batch(const std::vector<std::string>& inputs, const BatchOption
     const char* status = a.status == AssetStatus::Done ? "done" : a.status == AssetStatus::Skipped ? "skipped" : "failed";
     if (a.status == AssetStatus::Done) {
       ++summary.done;
-      accumulate(sums, a.stages);
+      accumulate_stages(sums, a.stages);
     }
     if (a.status == AssetStatus::Skipped) ++summary.skipped;
     if (a.status == AssetStatus::Failed) ++summary.failed;

@@ -66,11 +66,7 @@ SdfField compute_solids(Session& session, const io::Asset& asset, const io::Soli
     WeldResult welded = weld(positions, triangles, asset.weld_tolerance);
     session.set_mesh(std::move(welded.mesh));
     const SdfField f = session.compute(options);
-    for (const StageTiming& t : session.backend().last_timings()) {
-      auto it = std::find_if(stages.begin(), stages.end(), [&](const StageTiming& s) { return s.stage == t.stage; });
-      if (it == stages.end()) stages.push_back(t);
-      else it->milliseconds += t.milliseconds;
-    }
+    accumulate_stages(stages, session.backend().last_timings());
     const std::vector<std::uint32_t> rep_points = points_of(rep);
     for (const io::Solid& s : plan.solids) {
       if (s.group != static_cast<int>(g)) continue;

@@ -5,6 +5,7 @@
 #include "sdfkit/core/mesh.hpp"
 #include "sdfkit/core/sdf_definition.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -75,6 +76,15 @@ inline double total_milliseconds(std::span<const StageTiming> stages) {
   for (const StageTiming& s : stages)
     if (!s.nested) total += s.milliseconds;
   return total;
+}
+
+// Adds `stages` to the running sums by stage name, in the order of first appearance.
+inline void accumulate_stages(std::vector<StageTiming>& sums, std::span<const StageTiming> stages) {
+  for (const StageTiming& s : stages) {
+    auto it = std::find_if(sums.begin(), sums.end(), [&](const StageTiming& t) { return t.stage == s.stage; });
+    if (it == sums.end()) sums.push_back(s);
+    else it->milliseconds += s.milliseconds;
+  }
 }
 
 // Every backend implements this. A backend object is a session: it keeps its device context,
