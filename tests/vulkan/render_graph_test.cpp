@@ -121,6 +121,32 @@ TEST(RenderGraph, UnusedPassesAreCulledTransitivelyAndSideEffectsKept) {
   EXPECT_EQ(c.culled, (std::vector<std::string>{"make_a", "a_to_b"}));
 }
 
+// A write-only use starts a version independent of the earlier contents, so the earlier writer
+// dies when nothing reads its version; a pass that writes only part of the buffer declares
+// read-write, which keeps the earlier writer and orders it first.
+TEST(RenderGraph, PartialWriteKeepsTheEarlierWriterOnlyWhenDeclaredReadWrite) {
+  for (const bool read_write : {false, true}) {
+    RenderGraph g;
+    auto buf = g.create_buffer("half", 64);
+    auto out = g.import_buffer("out", 64, {});
+    auto first = g.add_pass("first_half", PassKind::Compute);
+    buf = first.storage_write(buf);
+    auto second = g.add_pass("second_half", PassKind::Compute);
+    buf = read_write ? second.storage_read_write(buf) : second.storage_write(buf);
+    auto consume = g.add_pass("consume", PassKind::Compute);
+    consume.storage_read(buf);
+    out = consume.storage_write(out);
+    const CompiledGraph c = g.compile();
+    if (read_write) {
+      EXPECT_EQ(order_of(c), (std::vector<std::string>{"first_half", "second_half", "consume"}));
+      EXPECT_TRUE(c.culled.empty());
+    } else {
+      EXPECT_EQ(order_of(c), (std::vector<std::string>{"second_half", "consume"}));
+      EXPECT_EQ(c.culled, std::vector<std::string>{"first_half"});
+    }
+  }
+}
+
 TEST(RenderGraph, WriteToStaleVersionIsAnError) {
   RenderGraph g;
   auto x0 = g.create_image("x", kColor);

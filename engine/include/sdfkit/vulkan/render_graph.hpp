@@ -186,6 +186,9 @@ public:
   void sampled(ImageHandle h);
   void storage_read(ImageHandle h);
   void storage_read(BufferHandle h);
+  // storage_write starts a new version that does not depend on the earlier contents: a pass
+  // writing only part of a resource that an earlier pass wrote, to be read together later,
+  // declares storage_read_write, or the earlier writer is culled when nothing else reads it.
   ImageHandle storage_write(ImageHandle h);
   BufferHandle storage_write(BufferHandle h);
   ImageHandle storage_read_write(ImageHandle h);
