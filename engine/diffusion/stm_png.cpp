@@ -4,15 +4,6 @@
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/io/asset.hpp"
 
-// Static: the render library compiles its own copy of stb_image_write.
-#define STB_IMAGE_WRITE_STATIC
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#include <stb/stb_image_write.h>
-#pragma GCC diagnostic pop
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -31,7 +22,7 @@ void write_atlas_png(const AtlasMapping& mapping, const Mesh& mesh, std::span<co
     if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
   if (!(hi > lo)) hi = lo + 1.0f;
   // Gutter and unused texels: black outside charts, dark grey inside a chart's rectangle.
-  std::vector<unsigned char> rgb(S * S * 3, 0);
+  std::vector<std::uint8_t> rgb(S * S * 3, 0);
   const auto put = [&](std::size_t x, std::size_t y, const glm::vec3& c) {
     unsigned char* px = &rgb[((S - 1 - y) * S + x) * 3];  // y up in the atlas, down in the PNG
     for (int k = 0; k < 3; ++k) px[k] = static_cast<unsigned char>(std::lround(std::clamp(c[k], 0.0f, 1.0f) * 255.0f));
@@ -68,13 +59,7 @@ void write_atlas_png(const AtlasMapping& mapping, const Mesh& mesh, std::span<co
         }
     }
   }
-  std::string bytes;
-  const auto append = [](void* context, void* data, int size) {
-    static_cast<std::string*>(context)->append(static_cast<const char*>(data), static_cast<std::size_t>(size));
-  };
-  const int n = static_cast<int>(S);
-  if (!stbi_write_png_to_func(append, &bytes, n, n, 3, rgb.data(), n * 3)) throw Error(path + ": PNG encoding failed");
-  io::write_file_atomically(path, [&](std::ostream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); });
+  io::write_png(path, static_cast<int>(S), static_cast<int>(S), 3, rgb);
 }
 
 }  // namespace sdfkit::diffusion

@@ -7,9 +7,6 @@
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/post/compare.hpp"
 
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include <stb/stb_image_write.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -214,18 +211,7 @@ Image render_figure(vk::Context& ctx, const Mesh& welded, std::span<const float>
 }
 
 void write_png(const std::string& path, const Image& image) {
-  if (image.width <= 0 || image.height <= 0 ||
-      image.rgba.size() != static_cast<std::size_t>(image.width) * image.height * 4)
-    throw Error(path + ": cannot write an empty or malformed image");
-  std::string bytes;
-  const auto append = [](void* context, void* data, int size) {
-    static_cast<std::string*>(context)->append(static_cast<const char*>(data), static_cast<std::size_t>(size));
-  };
-  if (!stbi_write_png_to_func(append, &bytes, image.width, image.height, 4, image.rgba.data(), image.width * 4))
-    throw Error(path + ": PNG encoding failed");
-  io::write_file_atomically(path, [&](std::ostream& out) {
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  });
+  io::write_png(path, image.width, image.height, 4, image.rgba);
 }
 
 }  // namespace sdfkit::render

@@ -17,6 +17,7 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -163,5 +164,11 @@ glm::vec3 colormap(float t);
 // failures as Error "<path>: <problem>").
 void write_file_atomically(const std::string& path,
                            const std::function<void(std::ostream&)>& write);
+
+// Writes 8-bit pixels (rows top to bottom, `channels` = 3 for RGB or 4 for RGBA) as a PNG file,
+// atomically (write_file_atomically). The one PNG encoder of the library (stb_image_write).
+// Throws Error for an empty or inconsistent image or a failed write.
+void write_png(const std::string& path, int width, int height, int channels,
+               std::span<const std::uint8_t> pixels);
 
 }  // namespace sdfkit::io
