@@ -507,29 +507,35 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     throw InputError("the BVH traversal cost must be positive, got " + std::to_string(params.traversal_cost));
   Builder b{params, {}};
   const auto degenerate = degenerate_faces(mesh);
-  std::size_t kept = 0;
-  for (std::uint8_t d : degenerate) kept += d == 0;
-  b.refs.resize(kept);
+  // Chunks of faces, each filling its own run of refs (after the kept faces of the chunks
+  // before it): face order, on all threads, with no per-face slot table.
+  const std::size_t faces = mesh.triangles.size();
+  const std::size_t chunks = std::clamp<std::size_t>(faces >> 16, 1, 64);
+  const auto chunk_begin = [&](std::size_t c) { return faces * c / chunks; };
+  std::vector<std::size_t> first_ref(chunks + 1, 0);
+  parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c)
+      first_ref[c + 1] = static_cast<std::size_t>(std::count(degenerate.begin() + static_cast<std::ptrdiff_t>(chunk_begin(c)),
+                                                             degenerate.begin() + static_cast<std::ptrdiff_t>(chunk_begin(c + 1)), 0));
+  }, 1);
+  for (std::size_t c = 0; c < chunks; ++c) first_ref[c + 1] += first_ref[c];
+  b.refs.resize(first_ref[chunks]);
   // Unpadded boxes, in face order, and the padding (as before: of the boxes' corners).
-  std::vector<std::uint32_t> slot_of(mesh.triangles.size() + 1, 0);
-  for (std::size_t f = 0, k = 0; f < mesh.triangles.size(); ++f) {
-    slot_of[f] = static_cast<std::uint32_t>(k);
-    k += degenerate[f] == 0;
-  }
-  std::vector<float> largest(std::thread::hardware_concurrency() + 1, 0.0f);
-  std::atomic<std::size_t> slot{0};
-  parallel_for(mesh.triangles.size(), [&](std::size_t begin, std::size_t end) {
-    float big = 0.0f;
-    for (std::size_t f = begin; f < end; ++f) {
-      if (degenerate[f]) continue;
-      Box box;
-      for (std::uint32_t v : mesh.triangles[f]) box.grow(mesh.positions[v]);
-      b.refs[slot_of[f]] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi, 0};
-      big = std::max({big, glm::length(box.lo), glm::length(box.hi)});
+  std::vector<float> largest(chunks, 0.0f);
+  parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c) {
+      float big = 0.0f;
+      std::size_t k = first_ref[c];
+      for (std::size_t f = chunk_begin(c); f < chunk_begin(c + 1); ++f) {
+        if (degenerate[f]) continue;
+        Box box;
+        for (std::uint32_t v : mesh.triangles[f]) box.grow(mesh.positions[v]);
+        b.refs[k++] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi, 0};
+        big = std::max({big, glm::length(box.lo), glm::length(box.hi)});
+      }
+      largest[c] = big;
     }
-    largest[slot++] = big;
-  }, 1 << 16);
-  slot_of = std::vector<std::uint32_t>();  // frees it (`= {}` would keep the capacity)
+  }, 1);
   const glm::vec3 pad(1e-6f * *std::max_element(largest.begin(), largest.end()) + std::numeric_limits<float>::min());
   parallel_for(b.refs.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) b.refs[i].lo -= pad, b.refs[i].hi += pad;
