@@ -193,19 +193,33 @@ struct Builder {
            Bins& out) const {
     // rel = (centroid - cbounds.lo) * scale and its truncation, lane for lane as in glm.
     const __m128 clo = vec4(cbounds.lo), sc = vec4(scale);
+    const auto bin_one = [&](const Ref& ref, Bins& r) {
+      const __m128 lo = ref_lo(ref), hi = ref_hi(ref);
+      alignas(16) std::int32_t k[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(k), _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centroid4(lo, hi), clo), sc)));
+      for (int axis = 0; axis < 3; ++axis) {
+        const int kk = std::min(bins - 1, k[axis]);
+        r.lo[axis][kk] = _mm_min_ps(lo, r.lo[axis][kk]);
+        r.hi[axis][kk] = _mm_max_ps(hi, r.hi[axis][kk]);
+        ++r.count[axis][kk];
+      }
+    };
+    // Neighbouring refs mostly fall in the same bins, and each update waits for the previous
+    // one's store: larger ranges alternate between two sets of bins, merged at the end. (The
+    // bounds do not depend on the order: min and max of finite values, and the padded boxes
+    // hold no -0.)
     const auto pass = [&](std::size_t b, std::size_t e, Bins& r) {
       r.reset(bins);
-      for (std::size_t i = b; i < e; ++i) {
-        const __m128 lo = ref_lo(refs[i]), hi = ref_hi(refs[i]);
-        alignas(16) std::int32_t k[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(k), _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centroid4(lo, hi), clo), sc)));
-        for (int axis = 0; axis < 3; ++axis) {
-          const int kk = std::min(bins - 1, k[axis]);
-          r.lo[axis][kk] = _mm_min_ps(lo, r.lo[axis][kk]);
-          r.hi[axis][kk] = _mm_max_ps(hi, r.hi[axis][kk]);
-          ++r.count[axis][kk];
-        }
+      if (e - b < 64) {
+        for (std::size_t i = b; i < e; ++i) bin_one(refs[i], r);
+        return;
       }
+      Bins other;
+      other.reset(bins);
+      std::size_t i = b;
+      for (; i + 1 < e; i += 2) bin_one(refs[i], r), bin_one(refs[i + 1], other);
+      if (i < e) bin_one(refs[i], r);
+      merge(r, other, bins);
     };
     if (end - begin < kParallelBinning) return pass(begin, end, out);
     std::vector<Bins> partial(std::thread::hardware_concurrency() + 1);
@@ -214,13 +228,15 @@ struct Builder {
     parallel_for(end - begin, [&](std::size_t b, std::size_t e) { pass(begin + b, begin + e, partial[slot++]); },
                  kParallelBinning / 2);
     out.reset(bins);
-    for (const Bins& p : partial)
-      for (int axis = 0; axis < 3; ++axis)
-        for (int k = 0; k < bins; ++k) {
-          out.lo[axis][k] = _mm_min_ps(p.lo[axis][k], out.lo[axis][k]);
-          out.hi[axis][k] = _mm_max_ps(p.hi[axis][k], out.hi[axis][k]);
-          out.count[axis][k] += p.count[axis][k];
-        }
+    for (const Bins& p : partial) merge(out, p, bins);
+  }
+  static void merge(Bins& into, const Bins& from, int bins) {
+    for (int axis = 0; axis < 3; ++axis)
+      for (int k = 0; k < bins; ++k) {
+        into.lo[axis][k] = _mm_min_ps(from.lo[axis][k], into.lo[axis][k]);
+        into.hi[axis][k] = _mm_max_ps(from.hi[axis][k], into.hi[axis][k]);
+        into.count[axis][k] += from.count[axis][k];
+      }
   }
 
   // Partitions refs [begin, end) by `left` in place (the same element order as libstdc++'s
