@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <span>
 #include <thread>
 #include <vector>
@@ -95,6 +96,65 @@ private:
   std::size_t mask_ = 0;
 };
 
+// The first pass's question, "has vertex i an earlier vertex within the tolerance?", through
+// an open-addressing table with one 8-byte entry per cell (32 bits of its hash, and its vertex
+// when it holds one, or kMulti), filled by all threads. A cell of one vertex, the usual case,
+// costs a lookup one run of neighbouring slots (one cache line, prefetched ahead), where the
+// chains cost a miss per step (head, next, position); a cell of several (or two cells whose
+// hashes share those bits) is answered by the chains, built only then.
+class Probe {
+public:
+  static constexpr std::uint32_t kMulti = UINT32_MAX - 1;
+  explicit Probe(std::size_t n) {
+    const std::size_t size = std::bit_ceil(std::max<std::size_t>(2 * n, 64));
+    slots_.reset(new std::uint64_t[size]);
+    mask_ = size - 1;
+    parallel_for(size, [&](std::size_t b, std::size_t e) {
+      std::fill(slots_.get() + b, slots_.get() + e, kEmpty);
+    }, std::size_t{1} << 18);
+  }
+  // Enters vertices [0, hashes.size()) on all threads (their slots do not matter to lookups);
+  // returns whether some cell holds several.
+  bool insert_all(std::span<const std::uint64_t> hashes) {
+    std::atomic<bool> multi{false};
+    parallel_for(hashes.size(), [&](std::size_t b, std::size_t e) {
+      bool local = false;
+      for (std::size_t i = b; i < e; ++i) {
+        const std::uint64_t tag = hashes[i] >> 32;
+        for (std::size_t k = hashes[i] & mask_;; k = (k + 1) & mask_) {
+          std::atomic_ref<std::uint64_t> slot(slots_[k]);
+          std::uint64_t seen = slot.load(std::memory_order_relaxed);
+          if (seen == kEmpty && slot.compare_exchange_strong(seen, tag << 32 | i, std::memory_order_relaxed))
+            break;
+          // Taken (seen now holds the entry): the same cell's makes it several, another goes on.
+          if (seen >> 32 == tag) {
+            slot.store(tag << 32 | kMulti, std::memory_order_relaxed);
+            local = true;
+            break;
+          }
+        }
+      }
+      if (local) multi = true;
+    }, std::size_t{1} << 15);
+    return multi;
+  }
+  void prefetch(std::uint64_t hash) const { __builtin_prefetch(&slots_[hash & mask_]); }
+  // The cell's vertex, kMulti, or kNone when no vertex has that hash.
+  std::uint32_t find(std::uint64_t hash) const {
+    const std::uint64_t tag = hash >> 32;
+    for (std::size_t k = hash & mask_;; k = (k + 1) & mask_) {
+      const std::uint64_t e = slots_[k];
+      if (e == kEmpty) return kNone;
+      if (e >> 32 == tag) return static_cast<std::uint32_t>(e);
+    }
+  }
+
+private:
+  static constexpr std::uint64_t kEmpty = UINT64_MAX;  // vertex 2^32 - 1 does not exist
+  std::unique_ptr<std::uint64_t[]> slots_;
+  std::size_t mask_ = 0;
+};
+
 }  // namespace
 
 float default_weld_tolerance(std::span<const glm::vec3> positions) {
@@ -128,11 +188,10 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
     const glm::vec3 d = a - b;
     return glm::dot(d, d) <= tol2;
   };
-  // Calls visit(j) for the vertices j < i in the buckets a match of p can lie in, each
-  // bucket's in increasing order until visit returns true.
-  Buckets buckets(n);
-  const auto for_candidates = [&](const glm::vec3& p, std::uint32_t i, auto&& visit) {
-    if (exact) return buckets.for_each_below(hash_of(p), i, visit);
+  // Calls visit_cell(hash) for the hash of every cell a match of p can lie in (exact: p's bucket),
+  // until it returns true; returns whether one did.
+  const auto any_cell = [&](const glm::vec3& p, auto&& visit_cell) {
+    if (exact) return visit_cell(hash_of(p));
     const double t = static_cast<double>(tolerance);
     std::int64_t lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
@@ -141,60 +200,91 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
     }
     for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
       for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-        for (std::int64_t z = lo[2]; z <= hi[2]; ++z) buckets.for_each_below(cell_hash(x, y, z), i, visit);
+        for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+          if (visit_cell(cell_hash(x, y, z))) return true;
+    return false;
   };
 
   constexpr std::size_t kGrain = 1 << 15;
   constexpr std::size_t kAhead = 16;  // prefetch distance, vertices
-  // In decreasing order (see Buckets::insert), bucket ranges on all threads.
-  {
-    std::vector<std::uint64_t> hashes(n);
-    parallel_for(n, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) hashes[i] = hash_of(positions[i]);
-    }, kGrain);
-    buckets.insert_all(hashes);
-  }
+  std::vector<std::uint64_t> hashes(n);  // of each vertex's own cell (exact: of its bits)
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) hashes[i] = hash_of(positions[i]);
+  }, kGrain);
 
   // rep[i]: the input vertex that i welds to. First pass, in parallel: a vertex with no earlier
   // vertex within the tolerance is its own; the others (kNone) are resolved in input order.
   std::vector<std::uint32_t> rep(n);
   std::atomic<std::size_t> pending{0};
-  parallel_for(n, [&](std::size_t b, std::size_t e) {
-    std::size_t local = 0;
-    for (std::size_t i = b; i < e; ++i) {
-      if (i + kAhead < e) buckets.prefetch(hash_of(positions[i + kAhead]));
-      const glm::vec3& p = positions[i];
-      bool earlier = false;
-      for_candidates(p, static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
-        earlier = earlier || same(positions[j], p);
-        return earlier;
-      });
-      rep[i] = earlier ? kNone : static_cast<std::uint32_t>(i);
-      local += earlier;
+  std::unique_ptr<Buckets> buckets;  // the chains, once some cell holds several vertices
+  const auto chains = [&] {
+    if (!buckets) {
+      buckets = std::make_unique<Buckets>(n);
+      buckets->insert_all(hashes);
     }
-    pending += local;
-  }, kGrain);
+    return buckets.get();
+  };
+  {
+    Probe probe(n);
+    const Buckets* several = probe.insert_all(hashes) ? chains() : nullptr;
+    parallel_for(n, [&](std::size_t b, std::size_t e) {
+      std::size_t local = 0;
+      for (std::size_t i = b; i < e; ++i) {
+        if (i + kAhead < e) probe.prefetch(hashes[i + kAhead]);
+        const glm::vec3& p = positions[i];
+        const auto below = static_cast<std::uint32_t>(i);
+        const bool earlier = any_cell(p, [&](std::uint64_t hash) {
+          const std::uint32_t v = probe.find(hash);
+          if (v != Probe::kMulti) return v < below && same(positions[v], p);
+          bool found = false;
+          several->for_each_below(hash, below, [&](std::uint32_t j) { return found = same(positions[j], p); });
+          return found;
+        });
+        rep[i] = earlier ? kNone : below;
+        local += earlier;
+      }
+      pending += local;
+    }, kGrain);
+  }
   if (pending > 0) {
     // Greedy in input order: i joins the earliest earlier vertex within the tolerance that is
-    // itself a welded vertex (all rep[j], j < i, are final here).
+    // itself a welded vertex (all rep[j], j < i, are final here). The chains list each bucket's
+    // vertices in increasing order (see Buckets::insert_all).
+    Buckets* bucket_chains = chains();
     for (std::size_t i = 0; i < n; ++i) {
       if (rep[i] != kNone) continue;
       const glm::vec3& p = positions[i];
       std::uint32_t best = kNone;
-      for_candidates(p, static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
-        if (j >= best) return true;  // a later bucket's candidates can only be earlier
-        if (rep[j] == j && same(positions[j], p)) {
-          best = j;
-          return true;
-        }
+      any_cell(p, [&](std::uint64_t hash) {
+        bucket_chains->for_each_below(hash, static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
+          if (j >= best) return true;  // a later bucket's candidates can only be earlier
+          if (rep[j] == j && same(positions[j], p)) {
+            best = j;
+            return true;
+          }
+          return false;
+        });
         return false;
       });
       rep[i] = best == kNone ? static_cast<std::uint32_t>(i) : best;
     }
   }
+  hashes = std::vector<std::uint64_t>();
 
-  // Number the welded vertices in input order; map every input vertex.
   WeldResult r;
+  if (pending == 0) {
+    // Nothing merges (the usual case for an indexed file): every vertex is its own and keeps
+    // its number, which is what the general path below gives, without its serial numbering
+    // pass and the triangles' gather through the map.
+    r.mesh.positions.assign(positions.begin(), positions.end());
+    r.mesh.triangles.assign(triangles.begin(), triangles.end());
+    r.input_to_welded.resize(n);
+    parallel_for(n, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) r.input_to_welded[i] = static_cast<std::uint32_t>(i);
+    }, kGrain);
+    return r;
+  }
+  // Number the welded vertices in input order; map every input vertex.
   r.input_to_welded.resize(n);
   std::uint32_t count = 0;
   for (std::size_t i = 0; i < n; ++i)

@@ -6,6 +6,8 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -46,6 +48,32 @@ struct Box {
   }
 };
 
+// Four-lane boxes (lane 3 unused) for the passes over the refs: the same min/max as Box::grow
+// (an accumulated value is replaced only by a strictly smaller or larger one), so the same
+// bounds bit for bit, in two SSE operations a box instead of six scalar ones.
+struct Box4 {
+  __m128 lo = _mm_set1_ps(std::numeric_limits<float>::max());
+  __m128 hi = _mm_set1_ps(-std::numeric_limits<float>::max());
+  void grow(__m128 l, __m128 h) {
+    lo = _mm_min_ps(l, lo);  // l < lo ? l : lo, as glm::min(lo, l)
+    hi = _mm_max_ps(h, hi);  // h > hi ? h : hi, as glm::max(hi, h)
+  }
+  void grow(__m128 p) { grow(p, p); }
+  // Box::half_area, the same operations in the same order: (x*y + y*z) + z*x, 0 when empty.
+  float half_area() const {
+    if (_mm_cvtss_f32(lo) > _mm_cvtss_f32(hi)) return 0.0f;
+    const __m128 e = _mm_sub_ps(hi, lo);
+    const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));  // xy, yz, zx
+    return (_mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1))) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 2));
+  }
+  Box box() const {
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    return Box{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+  }
+};
+
 // One triangle being partitioned: its padded box and face index, 32 bytes, moved as a whole so
 // that every pass over a node's triangles reads memory in order.
 struct Ref {
@@ -57,6 +85,15 @@ struct Ref {
 };
 static_assert(sizeof(Ref) == 32);
 static_assert(std::is_trivially_default_constructible_v<Ref>);
+
+// A ref's corners as four lanes, lane 3 zero (the face index's bits would be a denormal float).
+inline __m128 ref_lo(const Ref& r) {
+  return _mm_and_ps(_mm_loadu_ps(&r.lo.x), _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)));
+}
+inline __m128 ref_hi(const Ref& r) { return _mm_loadu_ps(&r.hi.x); }  // lane 3: pad, 0
+// Ref::centroid(), lane for lane.
+inline __m128 centroid4(__m128 lo, __m128 hi) { return _mm_mul_ps(_mm_add_ps(lo, hi), _mm_set1_ps(0.5f)); }
+inline __m128 vec4(const glm::vec3& v) { return _mm_set_ps(0.0f, v.z, v.y, v.x); }
 
 // Leaves a vector's new elements uninitialized: the refs (32 bytes per triangle, 426 MB at 13M)
 // are first written by the parallel fill, not zeroed on one thread before it.
@@ -111,10 +148,18 @@ struct Subtree {
 // Nodes with at least this many triangles bin on all threads (a pass over 1M refs is ~2 ms).
 constexpr std::size_t kParallelBinning = 1 << 18;
 
+// Per axis and bin: the bounds of the refs whose centroid falls in it, and their count. Only
+// the first `bins` of each axis are set (reset): most nodes are small, and setting all 3 x 16
+// (1.5 KB) per node cost more than their binning.
 struct Bins {
-  std::array<std::array<Box, kBins>, 3> box{};
-  std::array<std::array<std::size_t, kBins>, 3> count{};
-  Box bounds, cbounds;
+  __m128 lo[3][kBins], hi[3][kBins];
+  std::size_t count[3][kBins];
+  void reset(int bins) {
+    const __m128 big = _mm_set1_ps(std::numeric_limits<float>::max());
+    const __m128 small = _mm_set1_ps(-std::numeric_limits<float>::max());
+    for (int axis = 0; axis < 3; ++axis)
+      for (int k = 0; k < bins; ++k) lo[axis][k] = big, hi[axis][k] = small, count[axis][k] = 0;
+  }
 };
 
 struct Builder {
@@ -124,10 +169,14 @@ struct Builder {
   // Bounds and centroid bounds of refs [begin, end).
   void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds) const {
     const auto pass = [&](std::size_t b, std::size_t e, Box& bb, Box& cb) {
+      Box4 b4, c4;
       for (std::size_t i = b; i < e; ++i) {
-        bb.grow(Box{refs[i].lo, refs[i].hi});
-        cb.grow(refs[i].centroid());
+        const __m128 lo = ref_lo(refs[i]), hi = ref_hi(refs[i]);
+        b4.grow(lo, hi);
+        c4.grow(centroid4(lo, hi));
       }
+      bb.grow(b4.box());
+      cb.grow(c4.box());
     };
     if (end - begin < kParallelBinning) return pass(begin, end, bounds, cbounds);
     std::vector<Box> bb(std::thread::hardware_concurrency() + 1), cb(bb.size());
@@ -142,29 +191,52 @@ struct Builder {
   // Bins refs [begin, end) by centroid on the three axes.
   void bin(std::size_t begin, std::size_t end, int bins, const Box& cbounds, const glm::vec3& scale,
            Bins& out) const {
-    const auto pass = [&](std::size_t b, std::size_t e, Bins& r) {
-      for (std::size_t i = b; i < e; ++i) {
-        const Ref& ref = refs[i];
-        const glm::vec3 rel = (ref.centroid() - cbounds.lo) * scale;
-        const Box box{ref.lo, ref.hi};
-        for (int axis = 0; axis < 3; ++axis) {
-          const auto k = static_cast<std::size_t>(std::min(bins - 1, static_cast<int>(rel[axis])));
-          r.box[static_cast<std::size_t>(axis)][k].grow(box);
-          ++r.count[static_cast<std::size_t>(axis)][k];
-        }
+    // rel = (centroid - cbounds.lo) * scale and its truncation, lane for lane as in glm.
+    const __m128 clo = vec4(cbounds.lo), sc = vec4(scale);
+    const auto bin_one = [&](const Ref& ref, Bins& r) {
+      const __m128 lo = ref_lo(ref), hi = ref_hi(ref);
+      alignas(16) std::int32_t k[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(k), _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centroid4(lo, hi), clo), sc)));
+      for (int axis = 0; axis < 3; ++axis) {
+        const int kk = std::min(bins - 1, k[axis]);
+        r.lo[axis][kk] = _mm_min_ps(lo, r.lo[axis][kk]);
+        r.hi[axis][kk] = _mm_max_ps(hi, r.hi[axis][kk]);
+        ++r.count[axis][kk];
       }
+    };
+    // Neighbouring refs mostly fall in the same bins, and each update waits for the previous
+    // one's store: larger ranges alternate between two sets of bins, merged at the end. (The
+    // bounds do not depend on the order: min and max of finite values, and the padded boxes
+    // hold no -0.)
+    const auto pass = [&](std::size_t b, std::size_t e, Bins& r) {
+      r.reset(bins);
+      if (e - b < 64) {
+        for (std::size_t i = b; i < e; ++i) bin_one(refs[i], r);
+        return;
+      }
+      Bins other;
+      other.reset(bins);
+      std::size_t i = b;
+      for (; i + 1 < e; i += 2) bin_one(refs[i], r), bin_one(refs[i + 1], other);
+      if (i < e) bin_one(refs[i], r);
+      merge(r, other, bins);
     };
     if (end - begin < kParallelBinning) return pass(begin, end, out);
     std::vector<Bins> partial(std::thread::hardware_concurrency() + 1);
+    for (Bins& p : partial) p.reset(bins);
     std::atomic<std::size_t> slot{0};
     parallel_for(end - begin, [&](std::size_t b, std::size_t e) { pass(begin + b, begin + e, partial[slot++]); },
                  kParallelBinning / 2);
-    for (const Bins& p : partial)
-      for (std::size_t axis = 0; axis < 3; ++axis)
-        for (std::size_t k = 0; k < kBins; ++k) {
-          out.box[axis][k].grow(p.box[axis][k]);
-          out.count[axis][k] += p.count[axis][k];
-        }
+    out.reset(bins);
+    for (const Bins& p : partial) merge(out, p, bins);
+  }
+  static void merge(Bins& into, const Bins& from, int bins) {
+    for (int axis = 0; axis < 3; ++axis)
+      for (int k = 0; k < bins; ++k) {
+        into.lo[axis][k] = _mm_min_ps(from.lo[axis][k], into.lo[axis][k]);
+        into.hi[axis][k] = _mm_max_ps(from.hi[axis][k], into.hi[axis][k]);
+        into.count[axis][k] += from.count[axis][k];
+      }
   }
 
   // Partitions refs [begin, end) by `left` in place (the same element order as libstdc++'s
@@ -172,13 +244,19 @@ struct Builder {
   // measures both sides on the way, so that the children need no pass of their own.
   template <class Pred>
   std::size_t partition_measured(std::size_t begin, std::size_t end, Split& s, Pred left) {
-    Box* bb = s.child_bounds;
-    Box* cb = s.child_cbounds;
+    Box4 bb[2], cb[2];
     const auto take = [&](const Ref& r, int side) {
-      bb[side].grow(Box{r.lo, r.hi});
-      cb[side].grow(r.centroid());
+      const __m128 lo = ref_lo(r), hi = ref_hi(r);
+      bb[side].grow(lo, hi);
+      cb[side].grow(centroid4(lo, hi));
     };
     s.children_measured = true;
+    const std::size_t mid = partition_taking(begin, end, left, take);
+    for (int side = 0; side < 2; ++side) s.child_bounds[side] = bb[side].box(), s.child_cbounds[side] = cb[side].box();
+    return mid;
+  }
+  template <class Pred, class Take>
+  std::size_t partition_taking(std::size_t begin, std::size_t end, Pred left, Take take) {
     std::size_t first = begin, last = end;
     for (;;) {
       for (;;) {
@@ -221,28 +299,29 @@ struct Builder {
       glm::vec3 scale(0.0f);
       for (int axis = 0; axis < 3; ++axis)
         if (extent[axis] > 0.0f) scale[axis] = static_cast<float>(bins) / extent[axis];
-      Bins binned;
+      Bins binned;  // reset by bin
       bin(begin, end, bins, cbounds, scale, binned);
       float best_cost = std::numeric_limits<float>::max();
       int best_axis = -1, best_split = 0;
       for (int axis = 0; axis < 3; ++axis) {
         if (!(extent[axis] > 0.0f)) continue;
-        const auto& bb = binned.box[static_cast<std::size_t>(axis)];
-        const auto& bc = binned.count[static_cast<std::size_t>(axis)];
-        std::array<float, kBins> right_cost{};
-        Box acc;
+        const __m128* blo = binned.lo[axis];
+        const __m128* bhi = binned.hi[axis];
+        const std::size_t* bc = binned.count[axis];
+        float right_cost[kBins];  // [1, bins) set
+        Box4 acc;
         std::size_t count = 0;
         for (int b = bins - 1; b > 0; --b) {
-          acc.grow(bb[static_cast<std::size_t>(b)]);
-          count += bc[static_cast<std::size_t>(b)];
-          right_cost[static_cast<std::size_t>(b)] = acc.half_area() * static_cast<float>(count);
+          acc.grow(blo[b], bhi[b]);
+          count += bc[b];
+          right_cost[b] = acc.half_area() * static_cast<float>(count);
         }
-        acc = Box{};
+        acc = Box4{};
         count = 0;
         for (int b = 0; b < bins - 1; ++b) {
-          acc.grow(bb[static_cast<std::size_t>(b)]);
-          count += bc[static_cast<std::size_t>(b)];
-          const float cost = acc.half_area() * static_cast<float>(count) + right_cost[static_cast<std::size_t>(b) + 1];
+          acc.grow(blo[b], bhi[b]);
+          count += bc[b];
+          const float cost = acc.half_area() * static_cast<float>(count) + right_cost[b + 1];
           if (count > 0 && count < n && cost < best_cost) {
             best_cost = cost;
             best_axis = axis;
@@ -370,6 +449,9 @@ struct Builder {
       for (std::size_t k; (k = next++) < schedule.size();) {
         const Top& t = top[static_cast<std::size_t>(tasks[schedule[k]])];
         Subtree& part = parts[schedule[k]];
+        // At most 2m - 1 nodes for m triangles: no reallocation (and copy) while it grows; only
+        // the pages it fills are touched.
+        part.nodes.reserve(2 * (t.end - t.begin));
         part.nodes.emplace_back();
         build(part, 0, t.begin, t.end, t.depth, t.known ? Known{&t.bounds, &t.cbounds} : Known{});
       }
@@ -441,29 +523,35 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     throw InputError("the BVH traversal cost must be positive, got " + std::to_string(params.traversal_cost));
   Builder b{params, {}};
   const auto degenerate = degenerate_faces(mesh);
-  std::size_t kept = 0;
-  for (std::uint8_t d : degenerate) kept += d == 0;
-  b.refs.resize(kept);
+  // Chunks of faces, each filling its own run of refs (after the kept faces of the chunks
+  // before it): face order, on all threads, with no per-face slot table.
+  const std::size_t faces = mesh.triangles.size();
+  const std::size_t chunks = std::clamp<std::size_t>(faces >> 16, 1, 64);
+  const auto chunk_begin = [&](std::size_t c) { return faces * c / chunks; };
+  std::vector<std::size_t> first_ref(chunks + 1, 0);
+  parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c)
+      first_ref[c + 1] = static_cast<std::size_t>(std::count(degenerate.begin() + static_cast<std::ptrdiff_t>(chunk_begin(c)),
+                                                             degenerate.begin() + static_cast<std::ptrdiff_t>(chunk_begin(c + 1)), 0));
+  }, 1);
+  for (std::size_t c = 0; c < chunks; ++c) first_ref[c + 1] += first_ref[c];
+  b.refs.resize(first_ref[chunks]);
   // Unpadded boxes, in face order, and the padding (as before: of the boxes' corners).
-  std::vector<std::uint32_t> slot_of(mesh.triangles.size() + 1, 0);
-  for (std::size_t f = 0, k = 0; f < mesh.triangles.size(); ++f) {
-    slot_of[f] = static_cast<std::uint32_t>(k);
-    k += degenerate[f] == 0;
-  }
-  std::vector<float> largest(std::thread::hardware_concurrency() + 1, 0.0f);
-  std::atomic<std::size_t> slot{0};
-  parallel_for(mesh.triangles.size(), [&](std::size_t begin, std::size_t end) {
-    float big = 0.0f;
-    for (std::size_t f = begin; f < end; ++f) {
-      if (degenerate[f]) continue;
-      Box box;
-      for (std::uint32_t v : mesh.triangles[f]) box.grow(mesh.positions[v]);
-      b.refs[slot_of[f]] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi, 0};
-      big = std::max({big, glm::length(box.lo), glm::length(box.hi)});
+  std::vector<float> largest(chunks, 0.0f);
+  parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c) {
+      float big = 0.0f;
+      std::size_t k = first_ref[c];
+      for (std::size_t f = chunk_begin(c); f < chunk_begin(c + 1); ++f) {
+        if (degenerate[f]) continue;
+        Box box;
+        for (std::uint32_t v : mesh.triangles[f]) box.grow(mesh.positions[v]);
+        b.refs[k++] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi, 0};
+        big = std::max({big, glm::length(box.lo), glm::length(box.hi)});
+      }
+      largest[c] = big;
     }
-    largest[slot++] = big;
-  }, 1 << 16);
-  slot_of = std::vector<std::uint32_t>();  // frees it (`= {}` would keep the capacity)
+  }, 1);
   const glm::vec3 pad(1e-6f * *std::max_element(largest.begin(), largest.end()) + std::numeric_limits<float>::min());
   parallel_for(b.refs.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) b.refs[i].lo -= pad, b.refs[i].hi += pad;

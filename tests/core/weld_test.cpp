@@ -129,3 +129,38 @@ TEST(Weld, ManyCopiesOfOnePointWeldToTheFirst) {
     EXPECT_EQ(w.input_to_welded[7], tol > 0 ? 0u : 1u);
   }
 }
+
+TEST(Weld, NothingMergesGivesTheInputAndTheIdentityMap) {
+  // 48^3 lattice points 1 apart, shuffled (the parallel path): with a tolerance of 0.3 every
+  // grid cell (16 tolerances) holds ~100 candidates, none close enough (the chains answer);
+  // with 0.05 most cells hold one (the table answers); 0 compares bits. Nothing merges, and
+  // the input comes back as it is; one copy appended then welds through the general path and
+  // leaves every other vertex's number unchanged.
+  std::mt19937 rng(5);
+  std::vector<glm::vec3> p;
+  for (int x = 0; x < 48; ++x)
+    for (int y = 0; y < 48; ++y)
+      for (int z = 0; z < 48; ++z) p.push_back(glm::vec3(x, y, z) * 1.0f - 20.0f);
+  std::shuffle(p.begin(), p.end(), rng);
+  const auto n = static_cast<std::uint32_t>(p.size());
+  const std::vector<Triangle> tris = {{0, 1, 2}, {n - 1, 5, n + 7}};  // n + 7: out of range, copied
+  for (float tol : {0.3f, 0.05f, 0.0f}) {
+    SCOPED_TRACE(tol);
+    const WeldResult w = weld(p, tris, tol);
+    ASSERT_EQ(w.mesh.positions.size(), p.size());
+    for (std::uint32_t i = 0; i < n; ++i) {
+      ASSERT_EQ(w.input_to_welded[i], i);
+      ASSERT_EQ(w.mesh.positions[i], p[i]);
+    }
+    ASSERT_EQ(w.mesh.triangles.size(), tris.size());
+    for (std::size_t f = 0; f < tris.size(); ++f) EXPECT_EQ(w.mesh.triangles[f], tris[f]);
+
+    std::vector<glm::vec3> q = p;
+    q.push_back(p[1234] + glm::vec3(0.25f * tol, 0.0f, 0.0f));
+    const WeldResult m = weld(q, tris, tol);
+    ASSERT_EQ(m.mesh.positions.size(), p.size());
+    EXPECT_EQ(m.input_to_welded[n], 1234u);
+    for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(m.input_to_welded[i], i);
+    EXPECT_EQ(m.mesh.triangles[1], (Triangle{n - 1, 5, n + 7}));  // n + 7 is still out of range
+  }
+}

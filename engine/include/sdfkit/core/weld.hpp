@@ -30,10 +30,13 @@ float default_weld_tolerance(std::span<const glm::vec3> positions);
 // degenerate, not removed. Indices out of range are copied as they are.
 //
 // Found by hashing a grid of cells 16 x the tolerance (a match lies in the cells that the box of
-// +-tolerance around a point overlaps: 1 to 8 of them, ~1.2 on average): the table is filled in
-// one pass, looked up in parallel over the hardware threads, and only vertices that have an
-// earlier neighbour within the tolerance are then resolved in input order. Chains are kept in
-// index order, so many copies of one point cost linear time. Memory: ~4 x 2 + 12 bytes per input vertex beside the result.
+// +-tolerance around a point overlaps: 1 to 8 of them, ~1.2 on average): an open-addressing
+// table is filled and looked up in parallel over the hardware threads, and only vertices that
+// have an earlier neighbour within the tolerance are then resolved in input order, through
+// bucket chains kept in index order (many copies of one point cost linear time). When nothing
+// merges, the result is the input's copy with the identity map. Memory beside the result: 16 to
+// 32 bytes per input vertex for the table, 12 for hashes and representatives, 8 to 16 more for
+// the chains when something merges.
 WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> triangles,
                 float tolerance = 0.0f);
 
