@@ -87,3 +87,26 @@ TEST(Query, InvalidPointsAreDegenerateFacesAndIsolatedVertices) {
   EXPECT_EQ(f.valid, (std::vector<std::uint8_t>{1, 0}));
   EXPECT_GT(f.origin_offset, 0.0f);
 }
+
+TEST(Query, VertexOriginsViewTheMeshAndFaceOriginsOutliveCopies) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  // The vertex query's points are the mesh's own array (no 12 bytes per vertex beside it).
+  const SdfQuery v = make_query(m, SdfDomain::Vertex);
+  EXPECT_EQ(v.origins.data(), m.positions.data());
+  EXPECT_EQ(v.size(), m.positions.size());
+  EXPECT_EQ(v.origin_storage, nullptr);
+  // The face query's centroids are its own, and a copy made before the original is gone still
+  // reads them.
+  SdfQuery copy;
+  {
+    const SdfQuery f = make_query(m, SdfDomain::Face);
+    ASSERT_NE(f.origin_storage, nullptr);
+    EXPECT_EQ(f.origins.data(), f.origin_storage->data());
+    copy = f;
+  }
+  ASSERT_EQ(copy.size(), 4u);
+  EXPECT_EQ(copy.origins[3], (m.positions[1] + m.positions[2] + m.positions[3]) / 3.0f);
+  EXPECT_EQ(copy.origins[0], (m.positions[0] + m.positions[2] + m.positions[1]) / 3.0f);
+}

@@ -51,7 +51,7 @@ RawSdf DepthPeelBackend::compute_in_chunks(const SdfQuery& query, const SdfOptio
     SdfQuery part;
     part.domain = query.domain;
     part.origin_offset = query.origin_offset;
-    part.origins.assign(query.origins.begin() + static_cast<std::ptrdiff_t>(begin), query.origins.begin() + static_cast<std::ptrdiff_t>(end));
+    part.origins = query.origins.subspan(begin, end - begin);  // a view of the caller's points
     part.normals.assign(query.normals.begin() + static_cast<std::ptrdiff_t>(begin), query.normals.begin() + static_cast<std::ptrdiff_t>(end));
     if (!query.valid.empty())
       part.valid.assign(query.valid.begin() + static_cast<std::ptrdiff_t>(begin), query.valid.begin() + static_cast<std::ptrdiff_t>(end));

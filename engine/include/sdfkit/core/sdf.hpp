@@ -30,13 +30,17 @@ void validate_options(const SdfOptions& options);
 // vertices, degenerate faces) cast no ray and get filled values.
 struct SdfQuery {
   SdfDomain domain = SdfDomain::Vertex;
-  std::vector<glm::vec3> origins;         // the surface points (vertices or centroids)
+  // The surface points, a view: of the mesh's positions for vertices (make_query: the mesh must
+  // outlive the query), or of `origin_storage` when the points are computed (face centroids).
+  std::span<const glm::vec3> origins;
+  std::shared_ptr<const std::vector<glm::vec3>> origin_storage;  // shared: copies stay valid
   std::vector<glm::vec3> normals;         // unit outward normals (zero where invalid)
   std::vector<std::uint8_t> valid;        // 1 = cast rays from this point
   float origin_offset = 0.0f;             // kOriginOffset * bounding-box diagonal
   std::size_t size() const { return origins.size(); }
 };
 
+// The query of a mesh's vertices or faces; a vertex query's origins view mesh.positions.
 SdfQuery make_query(const Mesh& mesh, SdfDomain domain);
 
 // A backend's answer: per point, the gathered value and the number of kept rays (0 = no value).
