@@ -334,7 +334,7 @@ detail::CurveGraph surgery(const Surface& surface, const std::vector<float>& loc
 }
 
 Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
-               const SkeletonOptions& options, const ContractedProxy* proxy) {
+               const SkeletonOptions& options, const ContractedProxy* proxy, bool keep_handles) {
   const std::size_t n = original.positions.size();
 
   const double diag = bounding_box(original.positions).diagonal();
@@ -347,6 +347,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   so.sampling_weight = options.sampling_weight;
   so.grouping_global = options.ggt * diag;
   so.grouping_local = options.gmt;
+  so.keep_handles = keep_handles;
   Stopwatch watch;
   const Surface surface(original, contracted, sdf);
   // Grouping never joins nodes whose segment leaves the solid (a head grouped with the feet).
@@ -1279,6 +1280,49 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
 
 }  // namespace
 
+namespace {
+// Sum over the mesh's connected components of their genus, (2 - chi) / 2.
+int total_genus(const Mesh& mesh) {
+  UnionFind uf(mesh.positions.size());
+  for (const Triangle& t : mesh.triangles) uf.unite(t[0], t[1]), uf.unite(t[1], t[2]);
+  std::map<std::uint32_t, long long> chi;
+  std::vector<std::uint8_t> used(mesh.positions.size(), 0);
+  std::vector<std::array<std::uint32_t, 2>> edges;
+  for (const Triangle& t : mesh.triangles) {
+    chi[uf.find(t[0])] += 1;
+    for (int k = 0; k < 3; ++k) {
+      if (!used[t[k]]) used[t[k]] = 1, chi[uf.find(t[k])] += 1;
+      edges.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& e : edges) chi[uf.find(e[0])] -= 1;
+  int genus = 0;
+  for (const auto& [root, x] : chi) genus += static_cast<int>(std::max(0LL, (2 - x) / 2));
+  return genus;
+}
+
+// build() with the surgery's handle guard only where it is needed: the plain surgery (which
+// closes a loop whenever a collapse makes its hollow triangle degenerate) is kept when the
+// skeleton has as many independent cycles as the mesh's genus; otherwise a handle was closed
+// (a thin handle's ring contracted to a few nodes) and the surgery is rerun refusing the
+// collapses that close a loop round a hole of the solid, and the skeleton whose cycle count is
+// nearer the genus is kept (the plain one on a tie). Deterministic: both runs are.
+Skeleton build_keeping_handles(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+                               const SkeletonOptions& options, const ContractedProxy* proxy) {
+  Skeleton plain = build(original, contracted, sdf, options, proxy, false);
+  const int genus = total_genus(original);
+  const int plain_cycles = cycle_count(plain);
+  if (plain_cycles >= genus) return plain;
+  Skeleton guarded = build(original, contracted, sdf, options, proxy, true);
+  const int guarded_cycles = cycle_count(guarded);
+  log_debug("skeleton: " + std::to_string(plain_cycles) + " cycles for genus " + std::to_string(genus) +
+            "; with the surgery's handle guard " + std::to_string(guarded_cycles));
+  return std::abs(guarded_cycles - genus) < std::abs(plain_cycles - genus) ? guarded : plain;
+}
+}  // namespace
+
 Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
                         const SkeletonOptions& options) {
   validate(options);
@@ -1289,7 +1333,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   if (!sdf.empty() && sdf.size() != n)
     throw InputError("the SDF has " + std::to_string(sdf.size()) + " values for " +
                      std::to_string(n) + " vertices");
-  return build(original, contracted, sdf, options, nullptr);
+  return build_keeping_handles(original, contracted, sdf, options, nullptr);
 }
 
 namespace {
@@ -1367,9 +1411,9 @@ Skeleton extract_manifold(const Mesh& mesh, SdfBackend* backend, const Contracti
     for (std::size_t k = 0; k < mesh.positions.size(); ++k)
       contracted.positions[k] = c.contracted.positions[proxy.vertex_map[k]];
     const ContractedProxy contracted_proxy{c.contracted, proxy.vertex_map};
-    sk = build(mesh, contracted, sdf, options, &contracted_proxy);
+    sk = build_keeping_handles(mesh, contracted, sdf, options, &contracted_proxy);
   } else {
-    sk = build(mesh, c.contracted, sdf, options, nullptr);
+    sk = build_keeping_handles(mesh, c.contracted, sdf, options, nullptr);
   }
   seconds.build = seconds_since(t);
   sk.iterations = c.iterations;
