@@ -60,6 +60,7 @@ struct Surface {
     // otherwise (no SDF, or a vertex on a sharp edge whose cone estimate points past a
     // concavity) an inside point the vertex sees (see seen_inside_point).
     centre.resize(o.positions.size());
+    std::vector<std::uint8_t> centre_found(o.positions.size(), 1);
     parallel_for(o.positions.size(), [&](std::size_t begin, std::size_t end) {
       for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
         const glm::vec3 u = o.positions[k];
@@ -70,9 +71,55 @@ struct Surface {
             continue;
           }
         }
-        centre[k] = seen_inside_point(k, {u - normals[k], c.positions[k]}).value_or(c.positions[k]);
+        const std::optional<glm::vec3> seen = seen_inside_point(k, {u - normals[k], c.positions[k]});
+        centre_found[k] = seen.has_value();
+        centre[k] = seen.value_or(c.positions[k]);
       }
     });
+    // A vertex with no inside point it sees (a zero-thickness fin, a thin wing) takes its
+    // contracted position when that is inside, else the centre point of the nearest vertex
+    // (fewest mesh edges, then distance) that found one: never an unchecked point, so nodes
+    // placed from centre points stay inside. Only a component where no vertex found one keeps
+    // the contracted positions.
+    std::vector<std::vector<std::uint32_t>> ring(o.positions.size());
+    bool any_missing = false;
+    for (std::size_t k = 0; k < o.positions.size(); ++k) any_missing = any_missing || !centre_found[k];
+    if (any_missing) {
+      for (const Triangle& t : o.triangles)
+        for (int i = 0; i < 3; ++i) ring[t[i]].push_back(t[(i + 1) % 3]), ring[t[(i + 1) % 3]].push_back(t[i]);
+      for (auto& r : ring) {
+        std::sort(r.begin(), r.end());
+        r.erase(std::unique(r.begin(), r.end()), r.end());
+      }
+    }
+    for (auto k = static_cast<std::uint32_t>(0); k < o.positions.size(); ++k) {
+      if (centre_found[k]) continue;
+      if (bvh.inside(c.positions[k])) {
+        centre[k] = c.positions[k];
+        continue;
+      }
+      std::vector<std::uint32_t> frontier{k};
+      std::set<std::uint32_t> visited{k};
+      while (!frontier.empty()) {
+        std::uint32_t best = UINT32_MAX;
+        float best_d = std::numeric_limits<float>::infinity();
+        for (std::uint32_t v : frontier)
+          if (centre_found[v]) {
+            const float d = glm::length(o.positions[v] - o.positions[k]);
+            if (d < best_d || (d == best_d && v < best)) best_d = d, best = v;
+          }
+        if (best != UINT32_MAX) {
+          centre[k] = centre[best];
+          break;
+        }
+        std::vector<std::uint32_t> next;
+        for (std::uint32_t v : frontier)
+          for (std::uint32_t w : ring[v])
+            if (visited.insert(w).second) next.push_back(w);
+        std::sort(next.begin(), next.end());
+        frontier = std::move(next);
+      }
+    }
   }
 
   bool sees(std::uint32_t k, const glm::vec3& p) const {
