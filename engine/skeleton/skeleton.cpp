@@ -60,6 +60,7 @@ struct Surface {
     // otherwise (no SDF, or a vertex on a sharp edge whose cone estimate points past a
     // concavity) an inside point the vertex sees (see seen_inside_point).
     centre.resize(o.positions.size());
+    std::vector<std::uint8_t> centre_found(o.positions.size(), 1);
     parallel_for(o.positions.size(), [&](std::size_t begin, std::size_t end) {
       for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
         const glm::vec3 u = o.positions[k];
@@ -70,9 +71,55 @@ struct Surface {
             continue;
           }
         }
-        centre[k] = seen_inside_point(k, {u - normals[k], c.positions[k]}).value_or(c.positions[k]);
+        const std::optional<glm::vec3> seen = seen_inside_point(k, {u - normals[k], c.positions[k]});
+        centre_found[k] = seen.has_value();
+        centre[k] = seen.value_or(c.positions[k]);
       }
     });
+    // A vertex with no inside point it sees (a zero-thickness fin, a thin wing) takes its
+    // contracted position when that is inside, else the centre point of the nearest vertex
+    // (fewest mesh edges, then distance) that found one: never an unchecked point, so nodes
+    // placed from centre points stay inside. Only a component where no vertex found one keeps
+    // the contracted positions.
+    std::vector<std::vector<std::uint32_t>> ring(o.positions.size());
+    bool any_missing = false;
+    for (std::size_t k = 0; k < o.positions.size(); ++k) any_missing = any_missing || !centre_found[k];
+    if (any_missing) {
+      for (const Triangle& t : o.triangles)
+        for (int i = 0; i < 3; ++i) ring[t[i]].push_back(t[(i + 1) % 3]), ring[t[(i + 1) % 3]].push_back(t[i]);
+      for (auto& r : ring) {
+        std::sort(r.begin(), r.end());
+        r.erase(std::unique(r.begin(), r.end()), r.end());
+      }
+    }
+    for (auto k = static_cast<std::uint32_t>(0); k < o.positions.size(); ++k) {
+      if (centre_found[k]) continue;
+      if (bvh.inside(c.positions[k])) {
+        centre[k] = c.positions[k];
+        continue;
+      }
+      std::vector<std::uint32_t> frontier{k};
+      std::set<std::uint32_t> visited{k};
+      while (!frontier.empty()) {
+        std::uint32_t best = UINT32_MAX;
+        float best_d = std::numeric_limits<float>::infinity();
+        for (std::uint32_t v : frontier)
+          if (centre_found[v]) {
+            const float d = glm::length(o.positions[v] - o.positions[k]);
+            if (d < best_d || (d == best_d && v < best)) best_d = d, best = v;
+          }
+        if (best != UINT32_MAX) {
+          centre[k] = centre[best];
+          break;
+        }
+        std::vector<std::uint32_t> next;
+        for (std::uint32_t v : frontier)
+          for (std::uint32_t w : ring[v])
+            if (visited.insert(w).second) next.push_back(w);
+        std::sort(next.begin(), next.end());
+        frontier = std::move(next);
+      }
+    }
   }
 
   bool sees(std::uint32_t k, const glm::vec3& p) const {
@@ -334,7 +381,7 @@ detail::CurveGraph surgery(const Surface& surface, const std::vector<float>& loc
 }
 
 Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
-               const SkeletonOptions& options, const ContractedProxy* proxy) {
+               const SkeletonOptions& options, const ContractedProxy* proxy, bool keep_handles) {
   const std::size_t n = original.positions.size();
 
   const double diag = bounding_box(original.positions).diagonal();
@@ -347,6 +394,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   so.sampling_weight = options.sampling_weight;
   so.grouping_global = options.ggt * diag;
   so.grouping_local = options.gmt;
+  so.keep_handles = keep_handles;
   Stopwatch watch;
   const Surface surface(original, contracted, sdf);
   // Grouping never joins nodes whose segment leaves the solid (a head grouped with the feet).
@@ -1279,6 +1327,49 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
 
 }  // namespace
 
+namespace {
+// Sum over the mesh's connected components of their genus, (2 - chi) / 2.
+int total_genus(const Mesh& mesh) {
+  UnionFind uf(mesh.positions.size());
+  for (const Triangle& t : mesh.triangles) uf.unite(t[0], t[1]), uf.unite(t[1], t[2]);
+  std::map<std::uint32_t, long long> chi;
+  std::vector<std::uint8_t> used(mesh.positions.size(), 0);
+  std::vector<std::array<std::uint32_t, 2>> edges;
+  for (const Triangle& t : mesh.triangles) {
+    chi[uf.find(t[0])] += 1;
+    for (int k = 0; k < 3; ++k) {
+      if (!used[t[k]]) used[t[k]] = 1, chi[uf.find(t[k])] += 1;
+      edges.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& e : edges) chi[uf.find(e[0])] -= 1;
+  int genus = 0;
+  for (const auto& [root, x] : chi) genus += static_cast<int>(std::max(0LL, (2 - x) / 2));
+  return genus;
+}
+
+// build() with the surgery's handle guard only where it is needed: the plain surgery (which
+// closes a loop whenever a collapse makes its hollow triangle degenerate) is kept when the
+// skeleton has as many independent cycles as the mesh's genus; otherwise a handle was closed
+// (a thin handle's ring contracted to a few nodes) and the surgery is rerun refusing the
+// collapses that close a loop round a hole of the solid, and the skeleton whose cycle count is
+// nearer the genus is kept (the plain one on a tie). Deterministic: both runs are.
+Skeleton build_keeping_handles(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
+                               const SkeletonOptions& options, const ContractedProxy* proxy) {
+  Skeleton plain = build(original, contracted, sdf, options, proxy, false);
+  const int genus = total_genus(original);
+  const int plain_cycles = cycle_count(plain);
+  if (plain_cycles >= genus) return plain;
+  Skeleton guarded = build(original, contracted, sdf, options, proxy, true);
+  const int guarded_cycles = cycle_count(guarded);
+  log_debug("skeleton: " + std::to_string(plain_cycles) + " cycles for genus " + std::to_string(genus) +
+            "; with the surgery's handle guard " + std::to_string(guarded_cycles));
+  return std::abs(guarded_cycles - genus) < std::abs(plain_cycles - genus) ? guarded : plain;
+}
+}  // namespace
+
 Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
                         const SkeletonOptions& options) {
   validate(options);
@@ -1289,7 +1380,7 @@ Skeleton build_skeleton(const Mesh& original, const Mesh& contracted, const std:
   if (!sdf.empty() && sdf.size() != n)
     throw InputError("the SDF has " + std::to_string(sdf.size()) + " values for " +
                      std::to_string(n) + " vertices");
-  return build(original, contracted, sdf, options, nullptr);
+  return build_keeping_handles(original, contracted, sdf, options, nullptr);
 }
 
 namespace {
@@ -1367,9 +1458,9 @@ Skeleton extract_manifold(const Mesh& mesh, SdfBackend* backend, const Contracti
     for (std::size_t k = 0; k < mesh.positions.size(); ++k)
       contracted.positions[k] = c.contracted.positions[proxy.vertex_map[k]];
     const ContractedProxy contracted_proxy{c.contracted, proxy.vertex_map};
-    sk = build(mesh, contracted, sdf, options, &contracted_proxy);
+    sk = build_keeping_handles(mesh, contracted, sdf, options, &contracted_proxy);
   } else {
-    sk = build(mesh, c.contracted, sdf, options, nullptr);
+    sk = build_keeping_handles(mesh, c.contracted, sdf, options, nullptr);
   }
   seconds.build = seconds_since(t);
   sk.iterations = c.iterations;

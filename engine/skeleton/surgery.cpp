@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <queue>
+#include <set>
 
 namespace sdfkit::skeleton::detail {
 namespace {
@@ -95,6 +96,16 @@ public:
     for (std::uint32_t f : vf_[i])
       if (face_alive_[f] && (faces_[f][0] == j || faces_[f][1] == j || faces_[f][2] == j))
         return true;
+    return false;
+  }
+  bool face_with(std::uint32_t i, std::uint32_t j, std::uint32_t k) const {
+    for (std::uint32_t f : vf_[i])
+      if (face_alive_[f]) {
+        const Triangle& t = faces_[f];
+        const bool has_j = t[0] == j || t[1] == j || t[2] == j;
+        const bool has_k = t[0] == k || t[1] == k || t[2] == k;
+        if (has_j && has_k) return true;
+      }
     return false;
   }
   bool share_neighbour(std::uint32_t i, std::uint32_t j) const {
@@ -211,13 +222,33 @@ struct Candidate {
 // Q_j, the moved edges, or the sampling cost's edge lengths. (One entry per half-edge with
 // stale entries dropped at pop time made the same collapses with a far larger queue: CGAL's
 // hand, 991 collapses, 6.6 ms then, 4.3 ms now.)
-void remove_all_faces(Complex& c, const SurgeryOptions& o, std::size_t& collapses) {
+// A collapse i -> j identifies i with j, so every hollow triangle (i, j, k) — three edges and no
+// live triangle — becomes one edge and its loop dies. In a solid of genus 0 every loop bounds,
+// so that is harmless; in a component of genus > 0 the loop may go round a handle (a thin
+// handle's ring, contracted to a few nodes): it is kept when the triangle spanned by the
+// three nodes' embedded positions (the mean of their vertices' centre points) does not lie in
+// the solid — one of its sides leaves it. Such a loop goes round a hole of the solid.
+bool closes_handle(const Complex& c, std::uint32_t i, std::uint32_t j, const SurgeryOptions& o,
+                   const std::vector<std::uint8_t>& handles) {
+  if (!o.keep_handles || !o.segment_inside || !handles[c.members(i).front()]) return false;
+  for (std::uint32_t k : c.neighbours(i)) {
+    if (k == j || !contains(c.neighbours(j), k) || c.face_with(i, j, k)) continue;
+    const glm::vec3 a(c.embedded(i)), b(c.embedded(j)), d(c.embedded(k));
+    if (!o.segment_inside(a, b) || !o.segment_inside(b, d) || !o.segment_inside(d, a)) return true;
+  }
+  return false;
+}
+
+void remove_all_faces(Complex& c, const SurgeryOptions& o, const std::vector<std::uint8_t>& handles,
+                      std::size_t& collapses, std::size_t& kept_handles) {
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> queue;
+  std::set<std::pair<std::uint32_t, std::uint32_t>> refused;  // collapses that close a handle
   auto push_best = [&](std::uint32_t i) {
     c.bump(i);
     const double around = c.around(i);
     Candidate best{std::numeric_limits<double>::infinity(), i, i, c.stamp(i)};
     for (std::uint32_t j : c.face_neighbours(i)) {
+      if (refused.count({i, j})) continue;
       const double cost = c.cost(i, j, around, o.shape_weight, o.sampling_weight);
       if (cost < best.cost || (cost == best.cost && j < best.to)) best.cost = cost, best.to = j;
     }
@@ -229,6 +260,12 @@ void remove_all_faces(Complex& c, const SurgeryOptions& o, std::size_t& collapse
     queue.pop();
     if (!c.alive(e.from) || e.stamp != c.stamp(e.from)) continue;  // stale
     if (!c.alive(e.to) || !c.edge_on_face(e.from, e.to)) {
+      push_best(e.from);
+      continue;
+    }
+    if (closes_handle(c, e.from, e.to, o, handles)) {
+      refused.insert({e.from, e.to});
+      ++kept_handles;
       push_best(e.from);
       continue;
     }
@@ -363,6 +400,22 @@ void prune_spurious_cycles(Complex& c, const Mesh& mesh, std::size_t& pruned) {
   }
 }
 
+// First Betti number of the complex's edge graph (edges - live vertices + components); with no
+// triangle left, its number of independent cycles.
+std::size_t graph_cycles(const Complex& c) {
+  UnionFind uf(c.size());
+  std::size_t vertices = 0, edges = 0, components = 0;
+  for (std::uint32_t i = 0; i < c.size(); ++i)
+    if (c.alive(i)) {
+      ++vertices;
+      for (std::uint32_t j : c.neighbours(i))
+        if (i < j) ++edges, uf.unite(i, j);
+    }
+  for (std::uint32_t i = 0; i < c.size(); ++i)
+    if (c.alive(i) && uf.find(i) == i) ++components;
+  return edges + components - vertices;
+}
+
 }  // namespace
 
 CurveGraph collapse_to_curves(const Mesh& contracted, std::span<const float> radius,
@@ -370,16 +423,31 @@ CurveGraph collapse_to_curves(const Mesh& contracted, std::span<const float> rad
   Complex c(contracted, radius, centres);
   CurveGraph g;
   const auto t0 = std::chrono::steady_clock::now();
-  remove_all_faces(c, options, g.collapses);
+  std::vector<std::uint8_t> handles(contracted.positions.size(), 0);  // vertex in a genus > 0 component
+  if (options.keep_handles) {
+    UnionFind uf(contracted.positions.size());
+    const std::map<std::uint32_t, int> genus = component_genus(contracted, uf);
+    for (std::uint32_t v = 0; v < handles.size(); ++v) {
+      const auto it = genus.find(uf.find(v));
+      handles[v] = it != genus.end() && it->second > 0;
+    }
+  }
+  std::size_t kept_handles = 0;
+  remove_all_faces(c, options, handles, g.collapses, kept_handles);
   const auto t1 = std::chrono::steady_clock::now();
+  const std::size_t cycles_collapsed = graph_cycles(c);
   group_nodes(c, options, g.groupings);
+  const std::size_t cycles_grouped = graph_cycles(c);
   prune_spurious_cycles(c, contracted, g.pruned_cycles);
   const auto t2 = std::chrono::steady_clock::now();
   log_debug("surgery: " + std::to_string(g.collapses) + " collapses " +
             std::to_string(std::chrono::duration<double, std::milli>(t1 - t0).count()) + " ms, " +
             std::to_string(g.groupings) + " groupings " +
             std::to_string(std::chrono::duration<double, std::milli>(t2 - t1).count()) + " ms, " +
-            std::to_string(g.pruned_cycles) + " spurious cycles removed");
+            std::to_string(g.pruned_cycles) + " spurious cycles removed; " + std::to_string(kept_handles) +
+            " collapses refused (handle), " + std::to_string(c.alive_faces()) + " faces left; cycles after the collapses " +
+            std::to_string(cycles_collapsed) + ", after grouping " + std::to_string(cycles_grouped) +
+            ", kept " + std::to_string(graph_cycles(c)));
 
   std::vector<std::uint32_t> index(c.size(), UINT32_MAX);
   for (std::uint32_t i = 0; i < c.size(); ++i) {

@@ -20,6 +20,10 @@ struct SurgeryOptions {
   // When set, grouping never joins two nodes unless this holds for their embedded positions
   // (the skeleton: the segment between them stays inside the solid).
   std::function<bool(const glm::vec3&, const glm::vec3&)> segment_inside;
+  // In a mesh component of genus > 0, refuse a collapse that closes a hollow triangle whose
+  // embedded sides leave the solid (a loop round a hole; see collapse_to_curves). Needs
+  // segment_inside.
+  bool keep_handles = false;
 };
 
 struct CurveGraph {
