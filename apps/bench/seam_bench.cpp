@@ -12,7 +12,10 @@
 //    texture space is no further from heat than k-ring).
 // The field: a smooth wave over the bounding box plus seeded noise (the camel test's field).
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--atlas-size N] [--models] [MESH...]
+// With the band, each vertex is read back from every chart covering it, blended (StmOptions::blend),
+// unless --no-blend.
+//
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--no-blend] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -44,7 +47,7 @@ int main(int argc, char** argv) {
   CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
   std::vector<std::string> meshes;
   std::vector<float> sigmas;
-  bool no_band = false;
+  bool no_band = false, no_blend = false;
   std::uint32_t atlas_size = 2048;
   bool models = false;
   app.add_option("meshes", meshes, "Mesh files (closed)")->check(CLI::ExistingFile);
@@ -52,6 +55,7 @@ int main(int argc, char** argv) {
   std::string sigma_list = "1,2,3,5";
   app.add_option("--sigmas", sigma_list, "Sigmas in mean edge lengths, comma separated");
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
+  app.add_flag("--no-blend", no_blend, "Every vertex read back from its own chart only (no blend over the charts covering it)");
   app.add_option("--atlas-size", atlas_size, "Atlas size in texels")->check(CLI::Range(16, 16384));
   CLI11_PARSE(app, argc, argv);
   if (meshes.empty() && !models) {
@@ -73,9 +77,9 @@ int main(int argc, char** argv) {
   try {
     vk::Context ctx{vk::ContextConfig{}};
     diffusion::Diffuser diffuser(ctx);
-    std::printf("atlas %u², band %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
+    std::printf("atlas %u², band %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
                 "Against heat diffusion: texture Pearson / median rel. / RMS; k-ring RMS; tex/k = RMS ratio.\n\n",
-                atlas_size, no_band ? "none" : "3 sigma");
+                atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back");
     std::printf("| mesh | vertices | sigma (edges) | charts | atlas triangles / faces | seam ratio (heat) | pearson | median rel | "
                 "rms | k-ring (k) rms | tex/k | overlap | build_stm s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     std::vector<std::pair<std::string, std::function<Mesh()>>> inputs;
@@ -101,6 +105,7 @@ int main(int argc, char** argv) {
           diffusion::StmOptions so;
           so.atlas_size = atlas_size;
           so.overlap = no_band ? 0.0 : diffusion::kBandSigmas * sigma;
+          so.blend = !no_blend;
           const diffusion::Stm stm = diffusion::build_stm(m, skel, so);
           diffusion::DiffuseOptions o;
           o.sigma = sigma;

@@ -815,6 +815,21 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
   // face by face out of the faces it already holds, through faces its map keeps oriented as the
   // chart's own faces are and does not stretch: where the map folds (a planar chart reaching
   // around a limb, a bone chart past its end) the band stops.
+  // Blended read-back (StmOptions::blend): per chart, the vertices it covers and their weights.
+  struct BandSample {
+    std::uint32_t vertex, chart;
+    double weight;
+  };
+  std::vector<BandSample> band_samples;
+  std::vector<double> own_weight;
+  const bool blend = options.blend && options.overlap > 0;
+  const double blend_reach = kBlendShare * options.overlap;
+  // Smoothstep over [0, blend_reach] of the distance to where a chart's coverage ends.
+  const auto blend_weight = [&](double d) {
+    const double t = std::clamp(d / blend_reach, 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+  };
+  if (blend) own_weight.assign(V, 1.0);
   if (options.overlap > 0) {
     std::vector<std::uint32_t> vf_start(V + 1, 0), vf(3 * F);
     for (const Triangle& t : mesh.triangles)
@@ -832,6 +847,10 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     std::vector<std::uint8_t> face_state(F, 0);  // 1: in the chart, 2: rejected
     using Item = std::pair<double, std::uint32_t>;
     std::vector<Item> heap;
+    // Per chart, when blending: covered vertices; cover = inf (not covered), -1 (covered, coverage
+    // farther than the blend), or the distance to the coverage's end.
+    std::vector<std::uint32_t> covered;
+    std::vector<double> cover(blend ? V : 0, std::numeric_limits<double>::infinity());
     const std::size_t own_triangles = local.size();
     std::vector<std::vector<std::uint32_t>> held(maps.size());  // faces each chart holds already
     for (std::size_t i = 0; i < own_triangles; ++i) held[local[i].chart].push_back(local[i].face);
@@ -889,6 +908,44 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             ChartMap& m = maps[c];
             for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
           }
+      if (blend) {
+        // The vertices the chart covers (corners of its faces), and their distance along the
+        // surface to where its coverage ends (covered vertices with a face around them it lacks).
+        covered.clear();
+        for (std::uint32_t f : faces)
+          if (face_state[f] == 1)
+            for (std::uint32_t v : mesh.triangles[f])
+              if (!std::isfinite(cover[v])) cover[v] = -1, covered.push_back(v);
+        heap.clear();
+        for (std::uint32_t v : covered) {
+          bool inner = true;
+          for (std::uint32_t k = vf_start[v]; k < vf_start[v + 1] && inner; ++k) inner = face_state[vf[k]] == 1;
+          if (!inner) cover[v] = 0, heap.push_back({0.0, v});
+        }
+        std::make_heap(heap.begin(), heap.end(), std::greater<>());
+        while (!heap.empty()) {
+          std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+          const auto [d, a] = heap.back();
+          heap.pop_back();
+          if (d > cover[a] && cover[a] >= 0) continue;
+          if (d >= blend_reach) continue;
+          for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
+            const std::uint32_t b = adj[k];
+            if (std::isfinite(cover[b]) == false) continue;  // not covered
+            const double nd = d + glm::length(glm::dvec3(mesh.positions[a]) - glm::dvec3(mesh.positions[b]));
+            if (cover[b] >= 0 && nd >= cover[b]) continue;
+            cover[b] = nd;
+            heap.push_back({nd, b});
+            std::push_heap(heap.begin(), heap.end(), std::greater<>());
+          }
+        }
+        for (std::uint32_t v : covered) {
+          const double w = cover[v] < 0 ? 1.0 : blend_weight(cover[v]);
+          if (vchart[v] == c) own_weight[v] = w;
+          else if (w > 1e-4) band_samples.push_back({v, c, w});
+          cover[v] = std::numeric_limits<double>::infinity();
+        }
+      }
       for (std::uint32_t f : faces) face_state[f] = 0;
       for (std::uint32_t v : reached) dist[v] = std::numeric_limits<double>::infinity();
       reached.clear();
@@ -980,6 +1037,22 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     q.x = std::clamp(q.x, static_cast<float>(ch.x0), std::nextafter(static_cast<float>(ch.x0 + ch.width), 0.0f));
     q.y = std::clamp(q.y, static_cast<float>(ch.y0), std::nextafter(static_cast<float>(ch.y0 + ch.height), 0.0f));
     am.vertex_uv[v] = q;
+  }
+  if (blend) {
+    // The samples: every vertex's own chart, then the bands that cover it; sorted by vertex.
+    am.samples.reserve(V + band_samples.size());
+    for (std::size_t v = 0; v < V; ++v)
+      am.samples.push_back({static_cast<std::uint32_t>(v), vchart[v], am.vertex_uv[v],
+                            static_cast<float>(std::max(own_weight[v], 1e-4))});
+    for (const BandSample& b : band_samples) {
+      glm::vec2 q = to_texel(b.chart, local_coords(maps[b.chart], B, glm::dvec3(mesh.positions[b.vertex])));
+      const Chart& ch = am.charts[b.chart];
+      q.x = std::clamp(q.x, static_cast<float>(ch.x0), std::nextafter(static_cast<float>(ch.x0 + ch.width), 0.0f));
+      q.y = std::clamp(q.y, static_cast<float>(ch.y0), std::nextafter(static_cast<float>(ch.y0 + ch.height), 0.0f));
+      am.samples.push_back({b.vertex, b.chart, q, static_cast<float>(b.weight)});
+    }
+    std::stable_sort(am.samples.begin(), am.samples.end(),
+                     [](const VertexSample& a, const VertexSample& b) { return a.vertex < b.vertex; });
   }
 
   // 8. Quality.
