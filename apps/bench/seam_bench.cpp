@@ -6,7 +6,7 @@
 //    different charts, over the same P95 for the edges inside charts (the issue's ≤ 1.5), and
 //    in brackets the same ratio of the heat-diffused field (what the field gives without seams);
 //  - against intrinsic heat diffusion (t = sigma² / 2, cotangent Laplacian, 8 implicit steps,
-//    Eigen: tests/diffusion/diffuse_test_util.hpp, shared with the tests): Pearson, median
+//    the library's, through tests/diffusion/diffuse_test_util.hpp): Pearson, median
 //    relative difference and RMS difference of the texture-space result, and the RMS of k-ring
 //    smoothing at the same sigma (kring_for_sigma); "tex/k" is the ratio of the two RMS (≤ 1: the
 //    texture space is no further from heat than k-ring).
@@ -20,6 +20,7 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/diffusion/diffuse.hpp"
+#include "sdfkit/diffusion/seams.hpp"
 #include "sdfkit/diffusion/stm.hpp"
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/post/compare.hpp"
@@ -110,13 +111,11 @@ int main(int argc, char** argv) {
           diffusion::DiffuseOptions o;
           o.sigma = sigma;
           const std::vector<float> tex = diffuser.run(m, stm.mapping, u, o).values;
-          const test::SeamJumps s = test::seam_jumps(m, stm.mapping, tex);
-          const double ratio = s.border.empty() ? 0.0 : test::quantile(s.border, 0.95) / test::quantile(s.inside, 0.95);
+          const double ratio = diffusion::seam_ratio(m, stm.mapping, tex);
           const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
           // The same statistic of the heat field over the same partition of the edges: what the
           // field and where the borders lie give without any seam.
-          const test::SeamJumps hs = test::seam_jumps(m, stm.mapping, heat);
-          const double heat_ratio = hs.border.empty() ? 0.0 : test::quantile(hs.border, 0.95) / test::quantile(hs.inside, 0.95);
+          const double heat_ratio = diffusion::seam_ratio(m, stm.mapping, heat);
           SmoothOptions ko;
           ko.sigma = sigma;
           ko.rings = diffusion::kring_for_sigma(sigma, edge);
