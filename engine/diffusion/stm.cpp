@@ -851,6 +851,8 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     // farther than the blend), or the distance to the coverage's end.
     std::vector<std::uint32_t> covered;
     std::vector<double> cover(blend ? V : 0, std::numeric_limits<double>::infinity());
+    std::vector<double> dsum(blend ? V : 0, 0.0), dcnt(blend ? V : 0, 0.0);
+    const double distortion_k = kBlendDistortion;
     const std::size_t own_triangles = local.size();
     std::vector<std::vector<std::uint32_t>> held(maps.size());  // faces each chart holds already
     for (std::size_t i = 0; i < own_triangles; ++i) held[local[i].chart].push_back(local[i].face);
@@ -939,8 +941,39 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             std::push_heap(heap.begin(), heap.end(), std::greater<>());
           }
         }
+        // The chart's distortion around each covered vertex (StmOptions::blend): the mean over its
+        // faces in the chart of log² σ1 + log² σ2, σ1, σ2 the singular values of the map surface ->
+        // chart (both in model units, so 1 where the chart keeps lengths).
+        if (distortion_k > 0)
+          for (std::uint32_t f : faces) {
+            if (face_state[f] != 1) continue;
+            glm::dvec2 uv[3];
+            face_local(f, c, uv);
+            const Triangle& t = mesh.triangles[f];
+            const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
+                e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
+            const double l1 = glm::length(e1);
+            const glm::dvec3 n = glm::cross(e1, e2);
+            const double an = glm::length(n);
+            if (!(l1 > 0) || !(an > 0)) continue;
+            const glm::dvec3 ux = e1 / l1, uy = glm::cross(n / an, ux);
+            // P = [p1 p2] in the triangle's plane, D = [d1 d2] in the chart; J = D P^-1.
+            const double a = l1, b = glm::dot(e2, ux), cc = glm::dot(e2, uy);
+            const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+            // P^-1 = [[1/a, -b/(a cc)], [0, 1/cc]]
+            const double j11 = d1.x / a, j21 = d1.y / a;
+            const double j12 = (d2.x - b * j11) / cc, j22 = (d2.y - b * j21) / cc;
+            const double pe = 0.5 * (j11 + j22), pf = 0.5 * (j11 - j22), pg = 0.5 * (j21 + j12), ph = 0.5 * (j21 - j12);
+            const double sq = std::sqrt(pe * pe + ph * ph), sr = std::sqrt(pf * pf + pg * pg);
+            const double s1 = sq + sr, s2 = std::abs(sq - sr);
+            if (!(s2 > 1e-9)) continue;
+            const double delta = std::log(s1) * std::log(s1) + std::log(s2) * std::log(s2);
+            for (std::uint32_t v : t) dsum[v] += delta, dcnt[v] += 1;
+          }
         for (std::uint32_t v : covered) {
-          const double w = cover[v] < 0 ? 1.0 : blend_weight(cover[v]);
+          double w = cover[v] < 0 ? 1.0 : blend_weight(cover[v]);
+          if (distortion_k > 0 && dcnt[v] > 0) w *= std::exp(-distortion_k * dsum[v] / dcnt[v]);
+          dsum[v] = 0, dcnt[v] = 0;
           if (vchart[v] == c) own_weight[v] = w;
           else if (w > 1e-4) band_samples.push_back({v, c, w});
           cover[v] = std::numeric_limits<double>::infinity();

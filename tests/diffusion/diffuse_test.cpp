@@ -482,12 +482,13 @@ namespace {
 // (no SDF backend) and build_stm's atlas, with the overlap band of kBandSigmas sigma that the
 // blur needs (StmOptions::overlap) and every vertex read back from every chart covering it,
 // blended (StmOptions::blend). Against heat diffusion at 1..5 mean edges: Pearson >= 0.95, median
-// relative difference <= 5 %, no further from heat (RMS) than k-ring smoothing at the same sigma
-// (measured 0.80..0.89x its RMS), and no seams: the P95 jump across chart borders is at most 1.5
-// times the one inside charts (measured 0.97 / 1.02 / 1.09 / 1.13; the heat field's own ratio
-// over the same borders is 0.97..1.05). At 1 and 3 edges the blend and the band each lower the
-// seam ratio: read back from the own chart alone (measured 1.41 / 4.28), and one ring without the
-// band (3.97 / 13.5).
+// relative difference <= 5 %, at most 0.9x the RMS of k-ring smoothing at the same sigma (measured
+// 0.77 / 0.75 / 0.71 / 0.57x at 1 / 2 / 3 / 5 edges), and no seams: the P95 jump across chart
+// borders is at most 1.5 times the one inside charts (measured 0.98 / 1.02 / 1.04 / 1.14; the heat
+// field's own ratio over the same borders is 0.97..1.05). At 1 and 3 edges the blend and the band
+// each lower the seam ratio and the RMS: read back from the own chart alone (measured seam ratio
+// 1.41 / 4.28, RMS 0.0072 / 0.0073 against the blend's 0.0062 / 0.0065), and one ring without the
+// band (3.97 / 13.5, RMS 0.0084 / 0.0151).
 TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
   const Mesh m = io::load_asset(test::data_mesh("camel.off")).mesh;
   const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
@@ -504,7 +505,7 @@ TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
     const double ratio = seam_ratio(m, a, c.texture_values);
     EXPECT_GE(t.pearson, 0.95) << edges << " edges";
     EXPECT_LE(t.median_rel, 0.05) << edges << " edges";
-    EXPECT_LE(t.rms, k.rms) << edges << " edges";
+    EXPECT_LE(t.rms, 0.9 * k.rms) << edges << " edges";
     EXPECT_LE(ratio, 1.5) << edges << " edges";
     std::printf("camel sigma %.0f edges (%zu charts): texture pearson %.4f median %.4f rms %.4f seam ratio %.2f | "
                 "k-ring (k=%d) pearson %.4f median %.4f rms %.4f\n",
@@ -519,10 +520,7 @@ TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
     const HeatComparison c0 = compare_with_heat(*diffuser_, m, a0, u, sigma, edge);
     const double ratio0 = seam_ratio(m, a0, c0.texture_values);
     EXPECT_LT(ratio, ratio0) << edges << " edges";
-    // At 1 edge the blend is also closer to heat; at 3 a little further (measured 0.0082 against
-    // 0.0073: a band's reads are more distorted than the own chart's), still below k-ring's.
-    if (edges == 1.0f) EXPECT_LT(t.rms, c0.texture.rms);
-    else EXPECT_LE(t.rms, 1.2 * c0.texture.rms);
+    EXPECT_LT(t.rms, c0.texture.rms) << edges << " edges";
     // The band's effect: one ring, larger seams and further from heat diffusion still.
     const AtlasMapping a1 = build_stm(m, skel).mapping;
     ASSERT_EQ(a1.vertex_chart, a.vertex_chart) << "the band does not change which chart a vertex reads from";
