@@ -184,13 +184,13 @@ void validate_mapping(const Mesh& mesh, const AtlasMapping& m) {
   std::uint32_t next = 0;  // the samples: sorted by vertex, every vertex at least one
   for (std::size_t i = 0; i < m.samples.size(); ++i) {
     const VertexSample& s = m.samples[i];
-    const std::string which = "sample " + std::to_string(i) + " (vertex " + std::to_string(s.vertex) + ")";
+    const auto which = [&] { return "sample " + std::to_string(i) + " (vertex " + std::to_string(s.vertex) + ")"; };
     if (s.vertex >= V || s.vertex + 1 < next || s.vertex > next)
-      throw InputError(which + ": the samples must name every vertex, in order");
+      throw InputError(which() + ": the samples must name every vertex, in order");
     next = s.vertex + 1;
-    if (s.chart >= m.charts.size()) throw InputError(which + " reads from a chart that does not exist");
-    if (!inside(m.charts[s.chart], s.uv, 0.01f)) throw InputError(which + "'s uv lies outside its chart");
-    if (!(s.weight > 0.0f) || !std::isfinite(s.weight)) throw InputError(which + "'s weight is not positive");
+    if (s.chart >= m.charts.size()) throw InputError(which() + " reads from a chart that does not exist");
+    if (!inside(m.charts[s.chart], s.uv, 0.01f)) throw InputError(which() + "'s uv lies outside its chart");
+    if (!(s.weight > 0.0f) || !std::isfinite(s.weight)) throw InputError(which() + "'s weight is not finite and positive");
   }
   if (!m.samples.empty() && next != V) throw InputError("the samples must name every vertex, in order");
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {

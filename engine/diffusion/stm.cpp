@@ -810,11 +810,6 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
     }
   }
-  // 5b. Overlap bands (StmOptions::overlap): per chart, the faces within `overlap` of its own
-  // vertices along the surface (Dijkstra over the edges, from all its vertices at once), grown
-  // face by face out of the faces it already holds, through faces its map keeps oriented as the
-  // chart's own faces are and does not stretch: where the map folds (a planar chart reaching
-  // around a limb, a bone chart past its end) the band stops.
   // Blended read-back (StmOptions::blend): per chart, the vertices it covers and their weights.
   struct BandSample {
     std::uint32_t vertex, chart;
@@ -830,6 +825,11 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     return t * t * (3.0 - 2.0 * t);
   };
   if (blend) own_weight.assign(V, 1.0);
+  // 5b. Overlap bands (StmOptions::overlap): per chart, the faces within `overlap` of its own
+  // vertices along the surface (Dijkstra over the edges, from all its vertices at once), grown
+  // face by face out of the faces it already holds, through faces its map keeps oriented as the
+  // chart's own faces are and does not stretch: where the map folds (a planar chart reaching
+  // around a limb, a bone chart past its end) the band stops.
   if (options.overlap > 0) {
     std::vector<std::uint32_t> vf_start(V + 1, 0), vf(3 * F);
     for (const Triangle& t : mesh.triangles)

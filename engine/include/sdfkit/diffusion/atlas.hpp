@@ -53,7 +53,7 @@ struct AtlasMapping {
   std::uint32_t gutter = 2;               // texels between rectangles
   std::vector<Chart> charts;
   std::vector<AtlasTriangle> triangles;   // corner c of triangle t carries mesh vertex mesh.triangles[t.face][c]
-  std::vector<std::uint32_t> vertex_chart;  // V entries: the chart a vertex's value is read back from
+  std::vector<std::uint32_t> vertex_chart;  // V entries: the chart a vertex belongs to (and is read back from)
   std::vector<glm::vec2> vertex_uv;         // V entries: where, in atlas texels (inside that chart)
   // Optional blended read-back: when not empty, a vertex's value is the weight-normalized mean of
   // the reads of its samples (sorted by vertex, every vertex at least one, its own chart's among
