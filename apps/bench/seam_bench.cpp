@@ -11,6 +11,8 @@
 //    smoothing at the same sigma (kring_for_sigma); "tex/k" is the ratio of the two RMS (≤ 1: the
 //    texture space is no further from heat than k-ring).
 // The field: a smooth wave over the bounding box plus seeded noise (the camel test's field).
+// After the table, a summary per sigma over the meshes: the medians of the seam ratio and of
+// tex/k, and how many meshes meet seam ratio ≤ 1.5, tex/k ≤ 1 and Pearson ≥ 0.95.
 //
 // With the band, each vertex is read back from every chart covering it, blended (StmOptions::blend),
 // unless --no-blend.
@@ -83,6 +85,11 @@ int main(int argc, char** argv) {
                 atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back");
     std::printf("| mesh | vertices | sigma (edges) | charts | atlas triangles / faces | seam ratio (heat) | pearson | median rel | "
                 "rms | k-ring (k) rms | tex/k | overlap | build_stm s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    // Per sigma, over the meshes: seam ratio, tex/k, Pearson (the summary at the end).
+    struct Summary {
+      std::vector<double> seam, texk, pearson;
+    };
+    std::vector<Summary> summary(sigmas.size());
     std::vector<std::pair<std::string, std::function<Mesh()>>> inputs;
     for (const std::string& path : meshes)
       inputs.emplace_back(std::filesystem::path(path).stem().string(), [path] { return io::load_asset(path).mesh; });
@@ -101,7 +108,8 @@ int main(int argc, char** argv) {
         const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
         const std::vector<float> u = test::wave_field(m);
         const float edge = mean_edge_length(m);
-        for (float edges : sigmas) {
+        for (std::size_t si = 0; si < sigmas.size(); ++si) {
+          const float edges = sigmas[si];
           const float sigma = edges * edge;
           diffusion::StmOptions so;
           so.atlas_size = atlas_size;
@@ -127,11 +135,30 @@ int main(int argc, char** argv) {
                       static_cast<double>(stm.mapping.triangles.size()) / static_cast<double>(m.triangles.size()), ratio, heat_ratio,
                       c.pearson, 100.0 * c.median_relative, rms, krms, ko.rings, krms > 0 ? rms / krms : 0.0, 100.0 * stm.quality.overlap,
                       stm.quality.seconds);
+          summary[si].seam.push_back(ratio);
+          summary[si].texk.push_back(krms > 0 ? rms / krms : 0.0);
+          summary[si].pearson.push_back(c.pearson);
           std::fflush(stdout);
         }
       } catch (const Error& e) {
         std::printf("| %s | error: %s |\n", name.c_str(), e.what());
       }
+    }
+    // The summary: medians and counts against the targets (seam ratio ≤ 1.5, tex/k ≤ 1,
+    // Pearson ≥ 0.95).
+    const auto median = [](std::vector<double> v) { return diffusion::quantile(std::move(v), 0.5); };
+    const auto count = [](const std::vector<double>& v, auto pred) {
+      std::size_t n = 0;
+      for (double x : v) n += pred(x) ? 1 : 0;
+      return n;
+    };
+    std::printf("\n| sigma (edges) | meshes | seam ratio median | seam ratio <= 1.5 | tex/k median | tex/k <= 1 | pearson >= 0.95 |\n"
+                "|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (std::size_t si = 0; si < sigmas.size(); ++si) {
+      const Summary& u = summary[si];
+      std::printf("| %g | %zu | %.2f | %zu | %.2f | %zu | %zu |\n", static_cast<double>(sigmas[si]), u.seam.size(), median(u.seam),
+                  count(u.seam, [](double x) { return x <= 1.5; }), median(u.texk), count(u.texk, [](double x) { return x <= 1.0; }),
+                  count(u.pearson, [](double x) { return x >= 0.95; }));
     }
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
