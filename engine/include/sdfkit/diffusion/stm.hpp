@@ -55,7 +55,8 @@ struct StmOptions {
   // Overlap band, model units (0: only the triangles that touch a chart, one ring). Each chart
   // also carries the triangles within this distance along the surface (shortest edge paths)
   // of its own vertices, parameterized by the chart's map, as far as that map neither flips nor
-  // stretches them (a fold ends the band there), so a blur of σ sees the neighbouring charts'
+  // stretches them, nor (in a non-wrapping chart) lays them over triangles the chart already holds
+  // (a fold ends the band there), so a blur of σ sees the neighbouring charts'
   // surface up to the band, and (with `blend`) a vertex is read back from every chart whose band
   // covers it. smooth_texture_space sets it to kBandSigmas · σ from the blur's σ.
   double overlap = 0.0;
