@@ -269,19 +269,23 @@ std::pair<double, double> singular_values(double a, double b, double c, double d
 // Whether two triangles of a plane overlap by more than `eps` (separating axes over their six
 // edge normals; triangles that only touch along an edge or at a corner do not).
 bool triangles_overlap(const glm::dvec2 (&a)[3], const glm::dvec2 (&b)[3], double eps) {
+  // Bounding boxes first (most pairs of a grid cell are apart), then the edge normals.
+  const glm::dvec2 alo = glm::min(glm::min(a[0], a[1]), a[2]), ahi = glm::max(glm::max(a[0], a[1]), a[2]);
+  const glm::dvec2 blo = glm::min(glm::min(b[0], b[1]), b[2]), bhi = glm::max(glm::max(b[0], b[1]), b[2]);
+  if (ahi.x - blo.x <= eps || bhi.x - alo.x <= eps || ahi.y - blo.y <= eps || bhi.y - alo.y <= eps) return false;
   for (int pass = 0; pass < 2; ++pass) {
     const glm::dvec2(&t)[3] = pass == 0 ? a : b;
     for (int k = 0; k < 3; ++k) {
       const glm::dvec2 e = t[(k + 1) % 3] - t[k];
-      const glm::dvec2 n(-e.y, e.x);
-      const double len = glm::length(n);
+      const glm::dvec2 n(-e.y, e.x);  // unnormalized: projections and eps scale by |n|
+      const double len = std::sqrt(n.x * n.x + n.y * n.y);
       if (!(len > 0)) continue;
       double amin = 1e300, amax = -1e300, bmin = 1e300, bmax = -1e300;
       for (int i = 0; i < 3; ++i) {
-        const double pa = glm::dot(a[i], n) / len, pb = glm::dot(b[i], n) / len;
+        const double pa = glm::dot(a[i], n), pb = glm::dot(b[i], n);
         amin = std::min(amin, pa), amax = std::max(amax, pa), bmin = std::min(bmin, pb), bmax = std::max(bmax, pb);
       }
-      if (amax - bmin <= eps || bmax - amin <= eps) return false;
+      if (amax - bmin <= eps * len || bmax - amin <= eps * len) return false;
     }
   }
   return true;
@@ -889,7 +893,10 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     for (const Triangle& t : mesh.triangles)
       mean_edge += glm::length(glm::dvec3(mesh.positions[t[1]]) - glm::dvec3(mesh.positions[t[0]]));
     mean_edge /= static_cast<double>(std::max<std::size_t>(F, 1));
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;
+    // Cell -> the last of its entries; entries chain (next entry, triangle) without a vector per cell.
+    std::unordered_map<std::uint64_t, std::uint32_t> grid;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> grid_entries;
+    constexpr std::uint32_t kEnd = std::numeric_limits<std::uint32_t>::max();
     std::vector<std::array<glm::dvec2, 3>> grid_tris;
     std::vector<std::uint32_t> grid_faces;
     const auto cell_key = [&](long ix, long iy) {
@@ -907,7 +914,12 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       const auto id = static_cast<std::uint32_t>(grid_tris.size());
       grid_tris.push_back({uv[0], uv[1], uv[2]});
       grid_faces.push_back(f);
-      cells_of(uv, [&](std::uint64_t k) { grid[k].push_back(id); });
+      cells_of(uv, [&](std::uint64_t k) {
+        const auto [it, fresh] = grid.try_emplace(k, kEnd);
+        grid_entries.push_back({it->second, id});
+        it->second = static_cast<std::uint32_t>(grid_entries.size() - 1);
+        (void)fresh;
+      });
     };
     const auto grid_overlaps = [&](std::uint32_t f, const glm::dvec2 (&uv)[3]) {
       bool hit = false;
@@ -916,7 +928,8 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         if (hit) return;
         const auto it = grid.find(k);
         if (it == grid.end()) return;
-        for (std::uint32_t id : it->second) {
+        for (std::uint32_t e = it->second; e != kEnd; e = grid_entries[e].first) {
+          const std::uint32_t id = grid_entries[e].second;
           const Triangle& tg = mesh.triangles[grid_faces[id]];
           bool shares = false;
           for (std::uint32_t a : tf)
@@ -935,6 +948,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       const bool check_self = !(maps[c].kind == Chart::Kind::Bone && maps[c].wraps);
       if (check_self) {
         grid.clear();
+        grid_entries.clear();
         grid_tris.clear();
         grid_faces.clear();
         for (std::uint32_t f : held[c]) {
