@@ -1,8 +1,9 @@
 #version 450
-// Atlas sample: per vertex, the blurred atlas read back bilinearly at the vertex's uv inside its
-// own chart (clamped to the rectangle; wrapping in x for cylindrical charts), normalized by the
-// blurred coverage: sum(w · value·coverage) / sum(w · coverage). A vertex no covered texel
-// reaches keeps its fallback (its own value).
+// Atlas sample: per vertex, the blurred atlas read back bilinearly at each of its queries (a uv
+// inside a chart: clamped to the rectangle, wrapping in x for cylindrical charts), each read
+// normalized by the blurred coverage: sum(w · value·coverage) / sum(w · coverage); the reads
+// blended by the queries' weights (a partition of unity over the charts covering the vertex,
+// AtlasMapping::samples). A vertex no covered texel reaches keeps its fallback (its own value).
 #extension GL_GOOGLE_include_directive : require
 #include "atlas_common.glsl"
 
@@ -11,23 +12,28 @@ layout(local_size_x = 64) in;
 struct Query {
   vec2 uv;
   uint chart;
+  float weight;
+};
+struct Range {
+  uint first;
+  uint count;
   float fallback;
+  uint pad;
 };
 
 layout(std430, binding = 0) readonly buffer Charts { Chart charts[]; };
 layout(std430, binding = 1) readonly buffer Texels { vec2 texels[]; };  // tiled (atlas_common.glsl)
 layout(std430, binding = 2) readonly buffer Queries { Query queries[]; };
-layout(std430, binding = 3) writeonly buffer Values { float values[]; };
+layout(std430, binding = 3) readonly buffer Ranges { Range ranges[]; };
+layout(std430, binding = 4) writeonly buffer Values { float values[]; };
 
 layout(push_constant) uniform Push {
   uint vertex_count;
   uint size;
 } pc;
 
-void main() {
-  const uint i = gl_GlobalInvocationID.x;
-  if (i >= pc.vertex_count) return;
-  const Query q = queries[i];
+// The normalized bilinear read of query q; y = 0 where no covered texel reaches it.
+vec2 read(const Query q) {
   const Chart c = charts[q.chart];
   const int w = int(c.rect.z), h = int(c.rect.w);
   const vec2 p = q.uv - vec2(c.rect.xy) - 0.5;
@@ -48,5 +54,19 @@ void main() {
       acc += wgt * texels[tiled_index(c.rect.x + uint(x), c.rect.y + uint(y), pc.size)];
     }
   }
-  values[i] = acc.y > 1e-6 ? acc.x / acc.y : q.fallback;
+  return acc.y > 1e-6 ? vec2(acc.x / acc.y, 1.0) : vec2(0.0);
+}
+
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.vertex_count) return;
+  const Range r = ranges[i];
+  float sum = 0.0, weight = 0.0;
+  for (uint k = r.first; k < r.first + r.count; ++k) {
+    const Query q = queries[k];
+    const vec2 v = read(q);
+    sum += q.weight * v.x * v.y;
+    weight += q.weight * v.y;
+  }
+  values[i] = weight > 0.0 ? sum / weight : r.fallback;
 }

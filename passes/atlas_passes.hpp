@@ -31,13 +31,20 @@ struct RasterVertex {
 };
 static_assert(sizeof(RasterVertex) == 16);
 
-// One vertex to read back (atlas_sample.comp).
+// One read of a vertex's value (atlas_sample.comp): AtlasMapping's VertexSample.
 struct SampleQuery {
   glm::vec2 uv;        // atlas texels
   std::uint32_t chart;
-  float fallback;      // returned when no covered texel reaches the vertex
+  float weight;
 };
 static_assert(sizeof(SampleQuery) == 16);
+// A vertex's reads: queries [first, first + count), blended by weight.
+struct SampleRange {
+  std::uint32_t first, count;
+  float fallback;      // returned when no covered texel reaches any of them
+  std::uint32_t pad;
+};
+static_assert(sizeof(SampleRange) == 16);
 
 struct RasterPush {  // atlas_raster.vert
   glm::vec4 scale;   // x: 2 / atlas size
@@ -91,10 +98,11 @@ inline constexpr std::uint32_t kFusedMaxRadius = 127;
 // Lines up to this many texels the fused shader runs whole in private memory, at any radius.
 inline constexpr std::uint32_t kShortLine = 256;
 
-// Per vertex: the normalized bilinear read of the blurred texels. Returns the written `values`.
+// Per vertex: the weighted mean of the normalized bilinear reads of the blurred texels at its
+// queries (`ranges`: one SampleRange per vertex). Returns the written `values`.
 struct AtlasSamplePass {
   const vk::Pipeline* pipeline = nullptr;
-  vk::BufferHandle texels, charts, queries, values;
+  vk::BufferHandle texels, charts, queries, ranges, values;
   std::uint32_t vertex_count = 0, size = 0;
 };
 vk::BufferHandle add_atlas_sample_pass(vk::RenderGraph& graph, const AtlasSamplePass& pass);

@@ -181,6 +181,18 @@ void validate_mapping(const Mesh& mesh, const AtlasMapping& m) {
     if (!inside(m.charts[c], m.vertex_uv[v], 0.01f))
       throw InputError("vertex " + std::to_string(v) + "'s uv lies outside its chart " + std::to_string(c));
   }
+  std::uint32_t next = 0;  // the samples: sorted by vertex, every vertex at least one
+  for (std::size_t i = 0; i < m.samples.size(); ++i) {
+    const VertexSample& s = m.samples[i];
+    const auto which = [&] { return "sample " + std::to_string(i) + " (vertex " + std::to_string(s.vertex) + ")"; };
+    if (s.vertex >= V || s.vertex + 1 < next || s.vertex > next)
+      throw InputError(which() + ": the samples must name every vertex, in order");
+    next = s.vertex + 1;
+    if (s.chart >= m.charts.size()) throw InputError(which() + " reads from a chart that does not exist");
+    if (!inside(m.charts[s.chart], s.uv, 0.01f)) throw InputError(which() + "'s uv lies outside its chart");
+    if (!(s.weight > 0.0f) || !std::isfinite(s.weight)) throw InputError(which() + "'s weight is not finite and positive");
+  }
+  if (!m.samples.empty() && next != V) throw InputError("the samples must name every vertex, in order");
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {
     const AtlasTriangle& tri = m.triangles[t];
     if (tri.chart >= m.charts.size() || tri.face >= mesh.face_count())
@@ -207,7 +219,7 @@ struct Diffuser::Impl {
         raster(make_raster_pipeline(c)),
         blur(make_compute(c, "atlas_blur.comp", 4, sizeof(passes::BlurPush))),
         blur_box(make_compute(c, "atlas_blur_box.comp", 4, sizeof(passes::BlurPush))),
-        sample(make_compute(c, "atlas_sample.comp", 4, sizeof(passes::SamplePush))),
+        sample(make_compute(c, "atlas_sample.comp", 5, sizeof(passes::SamplePush))),
         dilate(make_compute(c, "atlas_dilate.comp", 3, sizeof(passes::DilatePush))),
         transients(c) {}
   vk::Context& ctx;
@@ -300,10 +312,33 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   if (!jobs.empty()) std::memcpy(job_buf.mapped(), jobs.data(), jobs.size() * sizeof(glm::uvec2));
 
   // Vertex queries and the read-back buffers.
-  vk::Buffer query_buf = make_buffer(ctx, V * sizeof(passes::SampleQuery), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+  // Vertex queries (the mapping's samples, or each vertex's own chart alone), their ranges per
+  // vertex, and the read-back buffers.
+  const bool blended = !mapping.samples.empty();
+  const std::size_t Q = blended ? mapping.samples.size() : V;
+  vk::Buffer query_buf = make_buffer(ctx, Q * sizeof(passes::SampleQuery), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                     vk::MemoryUse::Upload);
+  vk::Buffer range_buf = make_buffer(ctx, V * sizeof(passes::SampleRange), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                      vk::MemoryUse::Upload);
   auto* q = static_cast<passes::SampleQuery*>(query_buf.mapped());
-  for (std::size_t v = 0; v < V; ++v) q[v] = {mapping.vertex_uv[v], mapping.vertex_chart[v], values[v]};
+  auto* ranges = static_cast<passes::SampleRange*>(range_buf.mapped());
+  if (blended) {
+    for (std::size_t i = 0; i < Q; ++i) {
+      const VertexSample& s = mapping.samples[i];
+      q[i] = {s.uv, s.chart, s.weight};
+    }
+    std::size_t i = 0;
+    for (std::size_t v = 0; v < V; ++v) {
+      const std::size_t first = i;
+      while (i < Q && mapping.samples[i].vertex == v) ++i;
+      ranges[v] = {static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(i - first), values[v], 0u};
+    }
+  } else {
+    for (std::size_t v = 0; v < V; ++v) {
+      q[v] = {mapping.vertex_uv[v], mapping.vertex_chart[v], 1.0f};
+      ranges[v] = {static_cast<std::uint32_t>(v), 1u, values[v], 0u};
+    }
+  }
   vk::Buffer value_buf = make_buffer(ctx, V * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Readback);
   vk::Buffer atlas_buf;
   if (options.keep_atlas)
@@ -317,6 +352,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   const auto soup_h = graph.import_buffer("atlas.triangles", soup_buf.size, host_written(soup_buf));
   const auto job_h = graph.import_buffer("atlas.blur_jobs", job_buf.size, host_written(job_buf));
   const auto query_h = graph.import_buffer("atlas.queries", query_buf.size, host_written(query_buf));
+  const auto range_h = graph.import_buffer("atlas.ranges", range_buf.size, host_written(range_buf));
   const auto value_h = graph.import_buffer("atlas.values", value_buf.size, {value_buf.get()});
   const auto target = graph.create_image("atlas.raster", {kRasterFormat, size, size, 1});
   const auto texels = graph.create_buffer("atlas.texels", texel_bytes);
@@ -351,6 +387,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   sp.texels = blurred;
   sp.charts = chart_h;
   sp.queries = query_h;
+  sp.ranges = range_h;
   sp.values = value_h;
   sp.vertex_count = static_cast<std::uint32_t>(V);
   sp.size = size;

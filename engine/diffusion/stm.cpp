@@ -19,6 +19,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <unordered_map>
 
 namespace sdfkit::diffusion {
 namespace {
@@ -264,6 +265,31 @@ std::pair<double, double> singular_values(double a, double b, double c, double d
 }
 
 }  // namespace
+
+// Whether two triangles of a plane overlap by more than `eps` (separating axes over their six
+// edge normals; triangles that only touch along an edge or at a corner do not).
+bool triangles_overlap(const glm::dvec2 (&a)[3], const glm::dvec2 (&b)[3], double eps) {
+  // Bounding boxes first (most pairs of a grid cell are apart), then the edge normals.
+  const glm::dvec2 alo = glm::min(glm::min(a[0], a[1]), a[2]), ahi = glm::max(glm::max(a[0], a[1]), a[2]);
+  const glm::dvec2 blo = glm::min(glm::min(b[0], b[1]), b[2]), bhi = glm::max(glm::max(b[0], b[1]), b[2]);
+  if (ahi.x - blo.x <= eps || bhi.x - alo.x <= eps || ahi.y - blo.y <= eps || bhi.y - alo.y <= eps) return false;
+  for (int pass = 0; pass < 2; ++pass) {
+    const glm::dvec2(&t)[3] = pass == 0 ? a : b;
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec2 e = t[(k + 1) % 3] - t[k];
+      const glm::dvec2 n(-e.y, e.x);  // unnormalized: projections and eps scale by |n|
+      const double len = std::sqrt(n.x * n.x + n.y * n.y);
+      if (!(len > 0)) continue;
+      double amin = 1e300, amax = -1e300, bmin = 1e300, bmax = -1e300;
+      for (int i = 0; i < 3; ++i) {
+        const double pa = glm::dot(a[i], n), pb = glm::dot(b[i], n);
+        amin = std::min(amin, pa), amax = std::max(amax, pa), bmin = std::min(bmin, pb), bmax = std::max(bmax, pb);
+      }
+      if (amax - bmin <= eps * len || bmax - amin <= eps * len) return false;
+    }
+  }
+  return true;
+}
 
 Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -810,6 +836,21 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
     }
   }
+  // Blended read-back (StmOptions::blend): per chart, the vertices it covers and their weights.
+  struct BandSample {
+    std::uint32_t vertex, chart;
+    double weight;
+  };
+  std::vector<BandSample> band_samples;
+  std::vector<double> own_weight;
+  const bool blend = options.blend && options.overlap > 0;
+  const double blend_reach = kBlendShare * options.overlap;
+  // Smoothstep over [0, blend_reach] of the distance to where a chart's coverage ends.
+  const auto blend_weight = [&](double d) {
+    const double t = std::clamp(d / blend_reach, 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+  };
+  if (blend) own_weight.assign(V, 1.0);
   // 5b. Overlap bands (StmOptions::overlap): per chart, the faces within `overlap` of its own
   // vertices along the surface (Dijkstra over the edges, from all its vertices at once), grown
   // face by face out of the faces it already holds, through faces its map keeps oriented as the
@@ -832,10 +873,90 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     std::vector<std::uint8_t> face_state(F, 0);  // 1: in the chart, 2: rejected
     using Item = std::pair<double, std::uint32_t>;
     std::vector<Item> heap;
+    // Per chart, when blending: covered vertices; cover = inf (not covered), -1 (covered, coverage
+    // farther than the blend), or the distance to the coverage's end.
+    std::vector<std::uint32_t> covered;
+    std::vector<double> cover(blend ? V : 0, std::numeric_limits<double>::infinity());
+    std::vector<double> dsum(blend ? V : 0, 0.0), dcnt(blend ? V : 0, 0.0);
+    const double distortion_k = kBlendDistortion;
     const std::size_t own_triangles = local.size();
     std::vector<std::vector<std::uint32_t>> held(maps.size());  // faces each chart holds already
     for (std::size_t i = 0; i < own_triangles; ++i) held[local[i].chart].push_back(local[i].face);
+    // A band must not fold over its own chart either: in a non-wrapping chart (planar, cap) a
+    // band face whose chart triangle overlaps one the chart already holds (a planar map reaching
+    // round a limb onto its own far side, an azimuthal map past the antipode) stops the band
+    // there like a flip does, so no texel carries two parts of the surface for the blur to mix
+    // (elephant, sigma 5 edges: texels covered twice 7.1 % -> 0.35 %, RMS against heat
+    // 0.0368 -> 0.0331). The chart's triangles go in a uniform grid of its local coordinates,
+    // cell = the mean edge length; triangles sharing a vertex may touch.
+    double mean_edge = 0;
+    for (const Triangle& t : mesh.triangles)
+      mean_edge += glm::length(glm::dvec3(mesh.positions[t[1]]) - glm::dvec3(mesh.positions[t[0]]));
+    mean_edge /= static_cast<double>(std::max<std::size_t>(F, 1));
+    // Cell -> the last of its entries; entries chain (next entry, triangle) without a vector per cell.
+    std::unordered_map<std::uint64_t, std::uint32_t> grid;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> grid_entries;
+    constexpr std::uint32_t kEnd = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::array<glm::dvec2, 3>> grid_tris;
+    std::vector<std::uint32_t> grid_faces;
+    const auto cell_key = [&](long ix, long iy) {
+      return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(ix)) << 32) | static_cast<std::uint32_t>(iy);
+    };
+    const auto cells_of = [&](const glm::dvec2 (&uv)[3], auto&& fn) {
+      glm::dvec2 lo = glm::min(glm::min(uv[0], uv[1]), uv[2]), hi = glm::max(glm::max(uv[0], uv[1]), uv[2]);
+      const long x0 = static_cast<long>(std::floor(lo.x / mean_edge)), x1 = static_cast<long>(std::floor(hi.x / mean_edge));
+      const long y0 = static_cast<long>(std::floor(lo.y / mean_edge)), y1 = static_cast<long>(std::floor(hi.y / mean_edge));
+      if ((x1 - x0 + 1) * (y1 - y0 + 1) > 4096) return;
+      for (long x = x0; x <= x1; ++x)
+        for (long y = y0; y <= y1; ++y) fn(cell_key(x, y));
+    };
+    const auto grid_insert = [&](std::uint32_t f, const glm::dvec2 (&uv)[3]) {
+      const auto id = static_cast<std::uint32_t>(grid_tris.size());
+      grid_tris.push_back({uv[0], uv[1], uv[2]});
+      grid_faces.push_back(f);
+      cells_of(uv, [&](std::uint64_t k) {
+        const auto [it, fresh] = grid.try_emplace(k, kEnd);
+        grid_entries.push_back({it->second, id});
+        it->second = static_cast<std::uint32_t>(grid_entries.size() - 1);
+        (void)fresh;
+      });
+    };
+    const auto grid_overlaps = [&](std::uint32_t f, const glm::dvec2 (&uv)[3]) {
+      bool hit = false;
+      const Triangle& tf = mesh.triangles[f];
+      cells_of(uv, [&](std::uint64_t k) {
+        if (hit) return;
+        const auto it = grid.find(k);
+        if (it == grid.end()) return;
+        for (std::uint32_t e = it->second; e != kEnd; e = grid_entries[e].first) {
+          const std::uint32_t id = grid_entries[e].second;
+          const Triangle& tg = mesh.triangles[grid_faces[id]];
+          bool shares = false;
+          for (std::uint32_t a : tf)
+            for (std::uint32_t b : tg) shares = shares || a == b;
+          if (shares) continue;
+          const glm::dvec2 other[3] = {grid_tris[id][0], grid_tris[id][1], grid_tris[id][2]};
+          if (triangles_overlap(uv, other, 1e-3 * mean_edge)) {
+            hit = true;
+            return;
+          }
+        }
+      });
+      return hit;
+    };
     for (std::uint32_t c = 0; c < maps.size(); ++c) {
+      const bool check_self = !(maps[c].kind == Chart::Kind::Bone && maps[c].wraps);
+      if (check_self) {
+        grid.clear();
+        grid_entries.clear();
+        grid_tris.clear();
+        grid_faces.clear();
+        for (std::uint32_t f : held[c]) {
+          glm::dvec2 uv[3];
+          face_local(f, c, uv);
+          grid_insert(f, uv);
+        }
+      }
       // Distances along the surface from the chart's vertices, up to the band.
       heap.clear();
       for (std::uint32_t v : chart_vertices[c]) dist[v] = 0, reached.push_back(v), heap.push_back({0.0, v});
@@ -881,7 +1002,11 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             const double model = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
             const double loc = std::max({glm::length(lt.uv[1] - lt.uv[0]), glm::length(lt.uv[2] - lt.uv[1]),
                                          glm::length(lt.uv[0] - lt.uv[2])});
-            const bool ok = sign * signed_area2(lt.uv[0], lt.uv[1], lt.uv[2]) > 0 && loc <= options.max_stretch * model;
+            bool ok = sign * signed_area2(lt.uv[0], lt.uv[1], lt.uv[2]) > 0 && loc <= options.max_stretch * model;
+            if (ok && check_self) {
+              if (grid_overlaps(g, lt.uv)) ok = false;
+              else grid_insert(g, lt.uv);
+            }
             face_state[g] = ok ? 1 : 2;
             faces.push_back(g);
             if (!ok) continue;
@@ -889,6 +1014,75 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             ChartMap& m = maps[c];
             for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
           }
+      if (blend) {
+        // The vertices the chart covers (corners of its faces), and their distance along the
+        // surface to where its coverage ends (covered vertices with a face around them it lacks).
+        covered.clear();
+        for (std::uint32_t f : faces)
+          if (face_state[f] == 1)
+            for (std::uint32_t v : mesh.triangles[f])
+              if (!std::isfinite(cover[v])) cover[v] = -1, covered.push_back(v);
+        heap.clear();
+        for (std::uint32_t v : covered) {
+          bool inner = true;
+          for (std::uint32_t k = vf_start[v]; k < vf_start[v + 1] && inner; ++k) inner = face_state[vf[k]] == 1;
+          if (!inner) cover[v] = 0, heap.push_back({0.0, v});
+        }
+        std::make_heap(heap.begin(), heap.end(), std::greater<>());
+        while (!heap.empty()) {
+          std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+          const auto [d, a] = heap.back();
+          heap.pop_back();
+          if (d > cover[a] && cover[a] >= 0) continue;
+          if (d >= blend_reach) continue;
+          for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
+            const std::uint32_t b = adj[k];
+            if (std::isfinite(cover[b]) == false) continue;  // not covered
+            const double nd = d + glm::length(glm::dvec3(mesh.positions[a]) - glm::dvec3(mesh.positions[b]));
+            if (cover[b] >= 0 && nd >= cover[b]) continue;
+            cover[b] = nd;
+            heap.push_back({nd, b});
+            std::push_heap(heap.begin(), heap.end(), std::greater<>());
+          }
+        }
+        // The chart's distortion around each covered vertex (StmOptions::blend): the mean over its
+        // faces in the chart of log² σ1 + log² σ2, σ1, σ2 the singular values of the map surface ->
+        // chart (both in model units, so 1 where the chart keeps lengths).
+        if (distortion_k > 0)
+          for (std::uint32_t f : faces) {
+            if (face_state[f] != 1) continue;
+            glm::dvec2 uv[3];
+            face_local(f, c, uv);
+            const Triangle& t = mesh.triangles[f];
+            const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
+                e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
+            const double l1 = glm::length(e1);
+            const glm::dvec3 n = glm::cross(e1, e2);
+            const double an = glm::length(n);
+            if (!(l1 > 0) || !(an > 0)) continue;
+            const glm::dvec3 ux = e1 / l1, uy = glm::cross(n / an, ux);
+            // P = [p1 p2] in the triangle's plane, D = [d1 d2] in the chart; J = D P^-1.
+            const double a = l1, b = glm::dot(e2, ux), cc = glm::dot(e2, uy);
+            const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+            // P^-1 = [[1/a, -b/(a cc)], [0, 1/cc]]
+            const double j11 = d1.x / a, j21 = d1.y / a;
+            const double j12 = (d2.x - b * j11) / cc, j22 = (d2.y - b * j21) / cc;
+            const double pe = 0.5 * (j11 + j22), pf = 0.5 * (j11 - j22), pg = 0.5 * (j21 + j12), ph = 0.5 * (j21 - j12);
+            const double sq = std::sqrt(pe * pe + ph * ph), sr = std::sqrt(pf * pf + pg * pg);
+            const double s1 = sq + sr, s2 = std::abs(sq - sr);
+            if (!(s2 > 1e-9)) continue;
+            const double delta = std::log(s1) * std::log(s1) + std::log(s2) * std::log(s2);
+            for (std::uint32_t v : t) dsum[v] += delta, dcnt[v] += 1;
+          }
+        for (std::uint32_t v : covered) {
+          double w = cover[v] < 0 ? 1.0 : blend_weight(cover[v]);
+          if (distortion_k > 0 && dcnt[v] > 0) w *= std::exp(-distortion_k * dsum[v] / dcnt[v]);
+          dsum[v] = 0, dcnt[v] = 0;
+          if (vchart[v] == c) own_weight[v] = w;
+          else if (w > 1e-4) band_samples.push_back({v, c, w});
+          cover[v] = std::numeric_limits<double>::infinity();
+        }
+      }
       for (std::uint32_t f : faces) face_state[f] = 0;
       for (std::uint32_t v : reached) dist[v] = std::numeric_limits<double>::infinity();
       reached.clear();
@@ -980,6 +1174,22 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     q.x = std::clamp(q.x, static_cast<float>(ch.x0), std::nextafter(static_cast<float>(ch.x0 + ch.width), 0.0f));
     q.y = std::clamp(q.y, static_cast<float>(ch.y0), std::nextafter(static_cast<float>(ch.y0 + ch.height), 0.0f));
     am.vertex_uv[v] = q;
+  }
+  if (blend) {
+    // The samples: every vertex's own chart, then the bands that cover it; sorted by vertex.
+    am.samples.reserve(V + band_samples.size());
+    for (std::size_t v = 0; v < V; ++v)
+      am.samples.push_back({static_cast<std::uint32_t>(v), vchart[v], am.vertex_uv[v],
+                            static_cast<float>(std::max(own_weight[v], 1e-4))});
+    for (const BandSample& b : band_samples) {
+      glm::vec2 q = to_texel(b.chart, local_coords(maps[b.chart], B, glm::dvec3(mesh.positions[b.vertex])));
+      const Chart& ch = am.charts[b.chart];
+      q.x = std::clamp(q.x, static_cast<float>(ch.x0), std::nextafter(static_cast<float>(ch.x0 + ch.width), 0.0f));
+      q.y = std::clamp(q.y, static_cast<float>(ch.y0), std::nextafter(static_cast<float>(ch.y0 + ch.height), 0.0f));
+      am.samples.push_back({b.vertex, b.chart, q, static_cast<float>(b.weight)});
+    }
+    std::stable_sort(am.samples.begin(), am.samples.end(),
+                     [](const VertexSample& a, const VertexSample& b) { return a.vertex < b.vertex; });
   }
 
   // 8. Quality.

@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <cmath>
@@ -48,7 +50,7 @@ TEST(DiffuseCli, CompareDiffusionPutsKRingAndTextureSpaceBesideHeat) {
                                           " --diffusion --sigma-edges 1,10 --atlas-size 1024 --json " + json,
                                       dir.dir());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("| method | pearson | median relative | rms |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| method | pearson | median relative | rms | seam ratio |"), std::string::npos) << r.out;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
   ASSERT_EQ(j["rows"].size(), 6u);
@@ -63,6 +65,13 @@ TEST(DiffuseCli, CompareDiffusionPutsKRingAndTextureSpaceBesideHeat) {
     EXPECT_GE(tex["pearson"].get<double>(), 0.95) << e;
     EXPECT_LE(tex["median_relative"].get<double>(), 0.05) << e;
     EXPECT_GT(tex["rms"].get<double>(), 0.0) << e;  // not the heat values themselves
+    // Every row's seam ratio over the texture space's charts; texture space's no worse than 1.5x
+    // what the seamless heat field gives over the same borders.
+    ASSERT_TRUE(heat.contains("seam_ratio") && tex.contains("seam_ratio"));
+    std::printf("cylinder sigma %d edges: seam ratio heat %.3f, texture %.3f\n", e, heat["seam_ratio"].get<double>(),
+                tex["seam_ratio"].get<double>());
+    EXPECT_GT(heat["seam_ratio"].get<double>(), 0.0) << e;
+    EXPECT_LE(tex["seam_ratio"].get<double>(), 1.5 * std::max(1.0, heat["seam_ratio"].get<double>())) << e;
     const auto& kring = rows.at({e, "k-ring"});
     EXPECT_EQ(kring["rings"].get<int>(), 2 * e);
     EXPECT_GE(kring["pearson"].get<double>(), 0.95) << e;

@@ -2,7 +2,7 @@
 // Test-side tools for texture-space diffusion: intrinsic heat diffusion (the library's,
 // sdfkit/diffusion/heat.hpp), analytic shapes with mappings built by
 // hand (a cylinder as one wrapping chart or as overlapping non-wrapping charts, a box as one chart
-// per side), and the seam statistic.
+// per side). The seam statistic is the library's (sdfkit/diffusion/seams.hpp).
 
 #include "sdfkit/core/mesh.hpp"
 #include "sdfkit/core/shapes.hpp"
@@ -15,7 +15,6 @@
 #include <cmath>
 #include <numbers>
 #include <random>
-#include <set>
 #include <span>
 #include <utility>
 #include <vector>
@@ -135,32 +134,6 @@ inline diffusion::AtlasMapping cylinder_split_mapping(const Mesh& m, const Cylin
     a.vertex_uv.push_back(uv_in(p, i, j));
   }
   return a;
-}
-
-// Per mesh edge |u_a - u_b| / |x_a - x_b|, split into edges whose ends read back from different
-// charts (seams) and the others.
-struct SeamJumps {
-  std::vector<double> border, inside;
-};
-inline SeamJumps seam_jumps(const Mesh& m, const diffusion::AtlasMapping& a, std::span<const float> u) {
-  SeamJumps s;
-  std::set<std::pair<std::uint32_t, std::uint32_t>> seen;
-  for (const auto& tri : m.triangles)
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t p = tri[static_cast<std::size_t>(k)], q = tri[static_cast<std::size_t>((k + 1) % 3)];
-      if (p > q) std::swap(p, q);
-      if (!seen.insert({p, q}).second) continue;
-      const double jump = std::abs(static_cast<double>(u[p]) - u[q]) / glm::length(m.positions[p] - m.positions[q]);
-      (a.vertex_chart[p] != a.vertex_chart[q] ? s.border : s.inside).push_back(jump);
-    }
-  return s;
-}
-
-inline double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
 }
 
 inline double rms_difference(std::span<const float> a, std::span<const float> b) {

@@ -55,6 +55,35 @@ inline void expect_valid_stm(const Mesh& mesh, const diffusion::Stm& stm, const 
         << m.vertex_chart[v];
   }
   (void)S, (void)G;
+  // The blended read-back's samples (AtlasMapping::samples): only with a band and blending; sorted
+  // by vertex, every vertex once in its own chart at its own uv, other charts at most once, every
+  // weight in (0, 1], every uv inside its chart.
+  if (options.overlap > 0 && options.blend) {
+    ASSERT_GE(m.samples.size(), V);
+    std::size_t i = 0;
+    for (std::uint32_t v = 0; v < V; ++v) {
+      std::set<std::uint32_t> seen;
+      int own = 0;
+      ASSERT_LT(i, m.samples.size());
+      ASSERT_EQ(m.samples[i].vertex, v);
+      for (; i < m.samples.size() && m.samples[i].vertex == v; ++i) {
+        const diffusion::VertexSample& s = m.samples[i];
+        ASSERT_LT(s.chart, C);
+        ASSERT_TRUE(seen.insert(s.chart).second) << "vertex " << v << " samples chart " << s.chart << " twice";
+        EXPECT_TRUE(inside(m.charts[s.chart], s.uv)) << "vertex " << v << "'s sample outside chart " << s.chart;
+        EXPECT_GT(s.weight, 0.0f);
+        EXPECT_LE(s.weight, 1.0f);
+        if (s.chart == m.vertex_chart[v]) {
+          ++own;
+          EXPECT_EQ(s.uv, m.vertex_uv[v]);
+        }
+      }
+      ASSERT_EQ(own, 1) << "vertex " << v;
+    }
+    EXPECT_EQ(i, m.samples.size());
+  } else {
+    EXPECT_TRUE(m.samples.empty());
+  }
   // Atlas triangles.
   std::vector<std::set<std::uint32_t>> face_charts(mesh.triangles.size());
   const double tpu = stm.quality.texels_per_unit;

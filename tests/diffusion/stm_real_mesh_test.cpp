@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <limits>
 #include <vector>
 
@@ -73,7 +74,8 @@ TEST(StmExtracted, HumanHasFiniteBoundedDistortion) {
 // the vertices read from the same charts as without it, the charts carry more triangles, every
 // band triangle lies within the band (its nearest corner no further from the chart's vertices
 // than the band, straight-line distance being a lower bound of the distance along the surface)
-// and keeps the orientation of its chart's own faces (no fold), and a bad band is a usage error.
+// and keeps the orientation of its chart's own faces (no fold), under 1 % of the covered texels
+// carry two triangles, and a bad band is a usage error.
 TEST(StmExtracted, OverlapBandStaysInReachAndDoesNotFold) {
   const Mesh mesh = io::load_asset(test::data_mesh("camel.off")).mesh;
   const sk::Skeleton skel = sk::extract(mesh, nullptr, {}, {});
@@ -111,6 +113,10 @@ TEST(StmExtracted, OverlapBandStaysInReachAndDoesNotFold) {
     EXPECT_GT(area2(t) * (orientation[t.chart] >= 0 ? 1.0f : -1.0f), -1e-3f) << "face " << t.face << " folds in chart " << t.chart;
   }
   EXPECT_GT(band_triangles, mesh.triangles.size());
+  // Nor does a band lay its chart over itself (non-wrapping charts; a wrapping bone chart may still
+  // fold at a sharp bend): few texels carry two triangles (measured 0.094 %).
+  std::printf("camel, band 6 edges: %.3f %% of the covered texels carry two triangles\n", 100.0 * band.quality.overlap);
+  EXPECT_LT(band.quality.overlap, 0.01);
   for (double bad : {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     dif::StmOptions o;
     o.overlap = bad;

@@ -39,13 +39,28 @@ struct AtlasTriangle {
   glm::vec2 uv[3];                        // atlas texel coordinates of the corners, inside the chart's rectangle
 };
 
+// One read-back of a vertex's value: the blurred atlas at `uv` (atlas texels, inside `chart`'s
+// rectangle), weighted by `weight` (> 0) among the vertex's samples.
+struct VertexSample {
+  std::uint32_t vertex = 0;
+  std::uint32_t chart = 0;
+  glm::vec2 uv{0.0f};
+  float weight = 1.0f;
+};
+
 struct AtlasMapping {
   std::uint32_t size = 2048;              // atlas is size × size texels
   std::uint32_t gutter = 2;               // texels between rectangles
   std::vector<Chart> charts;
   std::vector<AtlasTriangle> triangles;   // corner c of triangle t carries mesh vertex mesh.triangles[t.face][c]
-  std::vector<std::uint32_t> vertex_chart;  // V entries: the chart a vertex's value is read back from
+  std::vector<std::uint32_t> vertex_chart;  // V entries: the chart a vertex belongs to (and is read back from)
   std::vector<glm::vec2> vertex_uv;         // V entries: where, in atlas texels (inside that chart)
+  // Optional blended read-back: when not empty, a vertex's value is the weight-normalized mean of
+  // the reads of its samples (sorted by vertex, every vertex at least one, its own chart's among
+  // them), each from a chart that covers it (its own, or a neighbour's overlap band), so the
+  // result is continuous across chart borders. Empty: every vertex reads vertex_chart at
+  // vertex_uv alone.
+  std::vector<VertexSample> samples;
 };
 
 }  // namespace sdfkit::diffusion

@@ -12,7 +12,9 @@
 //                 rectangle a chart sees zeros, and both channels are blurred, so the value read
 //                 back is blur(value·coverage) / blur(coverage) (normalized convolution): nothing
 //                 from another chart, from the gutter or from uncovered texels ever comes in
-//   atlas_sample  per vertex, bilinear at vertex_uv inside the vertex's chart, normalized
+//   atlas_sample  per vertex, bilinear at vertex_uv inside the vertex's chart, normalized; with
+//                 AtlasMapping::samples, the weighted blend of such reads in every chart covering
+//                 the vertex (build_stm's partition of unity across chart borders)
 //   atlas_dilate  (only when the atlas itself is asked for) the normalized atlas, uncovered texels
 //                 and half the gutter around each chart filled from the nearest covered texel of the
 //                 same chart, for a texture consumer (TEXCOORD_1) and the PNG
