@@ -2,6 +2,7 @@
 // assets that were in flight: every result complete before the kill is skipped, the rest are
 // computed, and every output ends up whole.
 #include "analytic.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -45,7 +46,8 @@ std::size_t lines(const fs::path& p) {
 }  // namespace
 
 TEST(BatchKill, RerunAfterSigkillRedoesOnlyWhatWasNotComplete) {
-  const fs::path dir = fs::temp_directory_path() / "sdfkit_batch_kill_test";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const fs::path dir = scratch.dir();
   fs::remove_all(dir);
   fs::create_directories(dir / "in");
   for (int i = 0; i < kAssets; ++i)

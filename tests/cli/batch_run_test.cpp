@@ -2,6 +2,7 @@
 // does not stop the others, results are atomic with per-asset records, a rerun resumes, and
 // shards split the work.
 #include "analytic.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -24,15 +25,12 @@ namespace {
 class BatchRun : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sdfkit_batch_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
+    dir_ = scratch_.dir();
     fs::create_directories(dir_ / "in");
     for (const char* m : {"cow.off", "elephant.off", "cube-ouvert.off"})
       fs::copy_file(sdfkit::test::data_mesh(m), dir_ / "in" / m);
     std::ofstream(dir_ / "in" / "broken.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n";
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   int batch(const std::string& args, int rays = 6) {
     const std::string cmd = std::string(SDFKIT_CLI) + " batch " + (dir_ / "in").string() + " --out " +
@@ -50,6 +48,7 @@ protected:
       out[fs::path(a.at("input").get<std::string>()).filename().string()] = a.at("status").get<std::string>();
     return out;
   }
+  sdfkit::test::ScratchDir scratch_;  // unique per run: two trees may run the suite at once
   fs::path dir_;
 };
 

@@ -2,6 +2,7 @@
 // error line naming the file and a non-zero exit, never a crash, and never a written output.
 #include "analytic.hpp"
 #include "run.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 
@@ -23,12 +24,8 @@ using sdfkit::test::slurp;
 class Cli : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sdfkit_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = scratch_.dir();
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   RunResult run(const std::string& args) {
     return sdfkit::test::run_command(std::string(SDFKIT_CLI) + " " + args, dir_);
@@ -46,6 +43,7 @@ protected:
     EXPECT_EQ(r.err.rfind("sdfkit: error: ", 0), 0u) << r.err;
     EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
   }
+  sdfkit::test::ScratchDir scratch_;  // unique per run: two trees may run the suite at once
   fs::path dir_;
 };
 

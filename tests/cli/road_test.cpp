@@ -4,6 +4,7 @@
 // error of every subcommand, and a batch rerun that recomputes when any option changed.
 #include "analytic.hpp"
 #include "run.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -22,12 +23,8 @@ using RunResult = sdfkit::test::CommandResult;
 class Road : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sdfkit_road_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = scratch_.dir();
   }
-  void TearDown() override { fs::remove_all(dir_); }
   RunResult run(const std::string& args) { return sdfkit::test::run_command(std::string(SDFKIT_CLI) + " " + args, dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   nlohmann::json json(const std::string& name) const {
@@ -41,6 +38,7 @@ protected:
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_NE(r.err.find(what), std::string::npos) << args << ": " << r.err;
   }
+  sdfkit::test::ScratchDir scratch_;  // unique per run: two trees may run the suite at once
   fs::path dir_;
 };
 

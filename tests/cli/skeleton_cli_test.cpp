@@ -2,6 +2,7 @@
 // curve along its axis, the glb output carries the skeleton as its own node and reads back as
 // the surface alone, and an open mesh is one clean error.
 #include "analytic.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -25,7 +26,8 @@ int run(const std::string& args, const fs::path& log) {
 }  // namespace
 
 TEST(SkeletonCli, CapsuleGivesOneCurveAlongItsAxis) {
-  const fs::path dir = fs::temp_directory_path() / "sdfkit_skeleton_cli";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const fs::path dir = scratch.dir();
   fs::remove_all(dir);
   fs::create_directories(dir);
   // --backend auto (the default) picks the OpenCL ray caster for skeletons when it has a device.
@@ -53,7 +55,8 @@ TEST(SkeletonCli, CapsuleGivesOneCurveAlongItsAxis) {
 }
 
 TEST(SkeletonCli, GlbCarriesTheSkeletonAndOpenMeshesAreRefused) {
-  const fs::path dir = fs::temp_directory_path() / "sdfkit_skeleton_cli_glb";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const fs::path dir = scratch.dir();
   fs::remove_all(dir);
   fs::create_directories(dir);
   ASSERT_EQ(run("skeleton builtin:torus -o " + (dir / "t.glb").string() + " --backend opencl --rays 12", dir / "log"), 0);

@@ -4,6 +4,7 @@
 #include "analytic.hpp"
 #include "run.hpp"
 #include "untrusted_fixture.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -20,18 +21,15 @@ namespace {
 class UntrustedBatch : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sdfkit_untrusted_batch_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = scratch_.dir();
     h_ = sdfkit::test::make_hostile_assets(dir_, "in");
     fs::copy_file(sdfkit::test::data_mesh("cow.off"), h_.assets / "cow.off");  // 5804 triangles
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   sdfkit::test::CommandResult run(const std::string& args) {
     return sdfkit::test::run_command(std::string(SDFKIT_CLI) + " " + args, dir_);
   }
+  sdfkit::test::ScratchDir scratch_;  // unique per run: two trees may run the suite at once
   fs::path dir_;
   sdfkit::test::HostileAssets h_;
 };

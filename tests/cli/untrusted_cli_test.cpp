@@ -5,6 +5,7 @@
 #include "analytic.hpp"
 #include "run.hpp"
 #include "untrusted_fixture.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,13 +20,9 @@ namespace {
 class UntrustedCli : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sdfkit_untrusted_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = scratch_.dir();
     h_ = sdfkit::test::make_hostile_assets(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   sdfkit::test::CommandResult run(const std::string& args) {
     return sdfkit::test::run_command(std::string(SDFKIT_CLI) + " " + args, dir_);
@@ -41,6 +38,7 @@ protected:
     return static_cast<std::size_t>(std::distance(fs::directory_iterator(d), fs::directory_iterator()));
   }
 
+  sdfkit::test::ScratchDir scratch_;  // unique per run: two trees may run the suite at once
   fs::path dir_;
   sdfkit::test::HostileAssets h_;
 };

@@ -3,6 +3,7 @@
 #include "sdfkit/core/sdf.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/io/asset.hpp"
+#include "scratch.hpp"
 
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
@@ -43,7 +44,8 @@ TEST(Overlay, SkeletonBecomesANodeWithLinesAndTriangles) {
   skel.lines = {{0, 1}, {1, 2}};
   skel.triangles = {{1, 2, 3}};
   o.overlays.push_back(skel);
-  const fs::path out = fs::temp_directory_path() / "sdfkit_overlay_test.glb";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const fs::path out = scratch.dir() / "sdfkit_overlay_test.glb";
   io::write_field(out.string(), asset_of(m), f, o);
 
   tinygltf::Model model;
@@ -73,7 +75,8 @@ TEST(Overlay, ReadingTheFileBackTakesOnlyTheSurface) {
   skel.lines = {{0, 1}};
   skel.triangles = {{0, 1, 2}};
   o.overlays.push_back(skel);
-  const fs::path out = fs::temp_directory_path() / "sdfkit_overlay_reread.glb";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const fs::path out = scratch.dir() / "sdfkit_overlay_reread.glb";
   io::write_field(out.string(), asset_of(m), f, o);
   const io::Asset back = io::load_asset(out.string());
   fs::remove(out);
@@ -90,7 +93,8 @@ TEST(Overlay, IndexOutOfRangeIsAnErrorAndWritesNothing) {
   bad.points = {{0, 0, 0}};
   bad.lines = {{0, 5}};
   o.overlays.push_back(bad);
-  const fs::path out = fs::temp_directory_path() / "sdfkit_overlay_bad.glb";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const fs::path out = scratch.dir() / "sdfkit_overlay_bad.glb";
   fs::remove(out);
   EXPECT_THROW(io::write_field(out.string(), asset_of(m), f, o), Error);
   EXPECT_FALSE(fs::exists(out));

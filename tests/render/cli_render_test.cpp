@@ -9,6 +9,7 @@
 #include "run.hpp"
 
 #include "sdfkit/pointcloud/skinning.hpp"
+#include "scratch.hpp"
 
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
@@ -47,12 +48,8 @@ double number_after(const std::string& text, const std::string& label) {
 class RenderCli : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("sdfkit_render_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = scratch_.dir();
   }
-  void TearDown() override { fs::remove_all(dir_); }
   RunResult run(const std::string& args) {
     const auto r = sdfkit::test::run_command(std::string(SDFKIT_CLI) + " " + args, dir_);
     return {r.exit_code, r.out, r.err};
@@ -75,6 +72,7 @@ protected:
     io::write_field(path(name), a, f);
     return a;
   }
+  sdfkit::test::ScratchDir scratch_;  // unique per run: two trees may run the suite at once
   fs::path dir_;
 };
 

@@ -7,6 +7,7 @@
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/render/figure.hpp"
+#include "scratch.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -165,7 +166,8 @@ TEST_F(Render, FigureHasColourBarAndHistogramAndWritesPng) {
     for (int x = 0; x < img.width; ++x) bar_pixels += is_background(img.pixel(x, y)) ? 0 : 1;
   EXPECT_GT(bar_pixels, 1000u);
 
-  const auto path = std::filesystem::temp_directory_path() / "sdfkit_render_test.png";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const auto path = scratch.dir() / "sdfkit_render_test.png";
   write_png(path.string(), img);
   std::ifstream f(path, std::ios::binary);
   char sig[8] = {};

@@ -10,6 +10,7 @@
 #include "sdfkit/io/asset.hpp"
 #include "sdfkit/render/figure.hpp"
 #include "sdfkit/skeleton/models.hpp"
+#include "scratch.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -95,7 +96,8 @@ TEST(SkeletonParts, LeavesBranchesAndSheetNodesByDegree) {
 }
 
 TEST(SkeletonFile, MeshSkeletonsPolylinesAndFrames) {
-  const auto dir = std::filesystem::temp_directory_path() / "sdfkit_skeleton_file_test";
+  const sdfkit::test::ScratchDir scratch;  // unique per run: two trees may run the suite at once
+  const auto dir = scratch.dir();
   std::filesystem::create_directories(dir);
   const auto write = [&](const std::string& name, const std::string& text) {
     std::ofstream((dir / name).string()) << text;
