@@ -776,17 +776,11 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
       std::vector<int> vertex_genus(n, 0);
       {
         UnionFind comp(n);
-        for (const Triangle& t : original.triangles) comp.unite(t[0], t[1]), comp.unite(t[1], t[2]);
-        std::map<std::uint32_t, long long> chi;
-        std::set<std::array<std::uint32_t, 2>> mesh_edges;
-        for (const Triangle& t : original.triangles) {
-          chi[comp.find(t[0])] += 1;
-          for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+        const std::map<std::uint32_t, int> genus = detail::component_genus(original, comp);
+        for (std::uint32_t k = 0; k < n; ++k) {
+          const auto it = genus.find(comp.find(k));
+          vertex_genus[k] = it == genus.end() ? 0 : it->second;
         }
-        for (std::uint32_t k = 0; k < n; ++k) chi[comp.find(k)] += 1;
-        for (const auto& me : mesh_edges) chi[comp.find(me[0])] -= 1;
-        for (std::uint32_t k = 0; k < n; ++k)
-          vertex_genus[k] = static_cast<int>(std::max(0LL, (2 - chi[comp.find(k)]) / 2));
       }
       auto in_handle_body = [&](std::uint32_t node) {
         return !sk.nodes[node].vertices.empty() && vertex_genus[sk.nodes[node].vertices.front()] > 0;
@@ -1331,22 +1325,8 @@ namespace {
 // Sum over the mesh's connected components of their genus, (2 - chi) / 2.
 int total_genus(const Mesh& mesh) {
   UnionFind uf(mesh.positions.size());
-  for (const Triangle& t : mesh.triangles) uf.unite(t[0], t[1]), uf.unite(t[1], t[2]);
-  std::map<std::uint32_t, long long> chi;
-  std::vector<std::uint8_t> used(mesh.positions.size(), 0);
-  std::vector<std::array<std::uint32_t, 2>> edges;
-  for (const Triangle& t : mesh.triangles) {
-    chi[uf.find(t[0])] += 1;
-    for (int k = 0; k < 3; ++k) {
-      if (!used[t[k]]) used[t[k]] = 1, chi[uf.find(t[k])] += 1;
-      edges.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  for (const auto& e : edges) chi[uf.find(e[0])] -= 1;
   int genus = 0;
-  for (const auto& [root, x] : chi) genus += static_cast<int>(std::max(0LL, (2 - x) / 2));
+  for (const auto& [root, g] : detail::component_genus(mesh, uf)) genus += g;
   return genus;
 }
 

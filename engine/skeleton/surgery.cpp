@@ -307,30 +307,6 @@ void group_nodes(Complex& c, const SurgeryOptions& o, std::size_t& groupings) {
 }
 
 
-// Genus of each connected component of a closed mesh, indexed by the component's root in the
-// returned union-find over vertices: g = (2 - (V - E + F)) / 2.
-std::map<std::uint32_t, int> component_genus(const Mesh& mesh, UnionFind& uf) {
-  for (const Triangle& t : mesh.triangles) uf.unite(t[0], t[1]), uf.unite(t[1], t[2]);
-  std::map<std::uint32_t, long long> chi;
-  std::vector<std::uint8_t> used(mesh.positions.size(), 0);
-  for (const Triangle& t : mesh.triangles) {
-    const std::uint32_t r = uf.find(t[0]);
-    chi[r] += 1;  // F
-    for (std::uint32_t v : t)
-      if (!used[v]) used[v] = 1, chi[r] += 1;  // V
-  }
-  std::vector<std::array<std::uint32_t, 2>> edges;
-  for (const Triangle& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k)
-      edges.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  for (const auto& e : edges) chi[uf.find(e[0])] -= 1;  // E
-  std::map<std::uint32_t, int> genus;
-  for (const auto& [r, x] : chi) genus[r] = static_cast<int>(std::max(0LL, (2 - x) / 2));
-  return genus;
-}
-
 void prune_spurious_cycles(Complex& c, const Mesh& mesh, std::size_t& pruned) {
   UnionFind mesh_uf(mesh.positions.size());
   const std::map<std::uint32_t, int> genus = component_genus(mesh, mesh_uf);
@@ -417,6 +393,30 @@ std::size_t graph_cycles(const Complex& c) {
 }
 
 }  // namespace
+
+// Genus of each connected component of a closed mesh, indexed by the component's root in the
+// returned union-find over vertices: g = (2 - (V - E + F)) / 2.
+std::map<std::uint32_t, int> component_genus(const Mesh& mesh, UnionFind& uf) {
+  for (const Triangle& t : mesh.triangles) uf.unite(t[0], t[1]), uf.unite(t[1], t[2]);
+  std::map<std::uint32_t, long long> chi;
+  std::vector<std::uint8_t> used(mesh.positions.size(), 0);
+  for (const Triangle& t : mesh.triangles) {
+    const std::uint32_t r = uf.find(t[0]);
+    chi[r] += 1;  // F
+    for (std::uint32_t v : t)
+      if (!used[v]) used[v] = 1, chi[r] += 1;  // V
+  }
+  std::vector<std::array<std::uint32_t, 2>> edges;
+  for (const Triangle& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      edges.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& e : edges) chi[uf.find(e[0])] -= 1;  // E
+  std::map<std::uint32_t, int> genus;
+  for (const auto& [r, x] : chi) genus[r] = static_cast<int>(std::max(0LL, (2 - x) / 2));
+  return genus;
+}
 
 CurveGraph collapse_to_curves(const Mesh& contracted, std::span<const float> radius,
                               std::span<const glm::vec3> centres, const SurgeryOptions& options) {

@@ -3,10 +3,12 @@
 // until no triangle is left, then SDF grouping of nodes closer than their grouping distance.
 
 #include "sdfkit/core/mesh.hpp"
+#include "sdfkit/core/union_find.hpp"
 
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <span>
 #include <vector>
 
@@ -55,5 +57,9 @@ struct CurveGraph {
 // lengths between embedded positions) are kept; the closing edges of the others are removed.
 CurveGraph collapse_to_curves(const Mesh& contracted, std::span<const float> radius,
                               std::span<const glm::vec3> centres, const SurgeryOptions& options);
+
+// Genus of each connected component of a closed mesh, (2 - (V - E + F)) / 2, keyed by the
+// component's root in `uf` (a union-find over the mesh's vertices, united here).
+std::map<std::uint32_t, int> component_genus(const Mesh& mesh, UnionFind& uf);
 
 }  // namespace sdfkit::skeleton::detail
