@@ -121,8 +121,15 @@ TriangleBvh::Hit TriangleBvh::closest(const glm::vec3& o, const glm::vec3& dir, 
   return hit;
 }
 
-bool TriangleBvh::segment_blocked(const glm::vec3& a, const glm::vec3& b,
+bool TriangleBvh::segment_blocked(const glm::vec3& from, const glm::vec3& to,
                                   std::uint32_t skip_vertex) const {
+  // The segment is traced from its lexicographically smaller end, so that the answer is a
+  // property of the segment, not of the direction asked: a segment that grazes a triangle's
+  // edge could be blocked one way and clear the other (boeing, oblong-shuffled: curve edges
+  // checked inside as c -> b and counted outside as b -> c).
+  const bool swap = to.x != from.x ? to.x < from.x : (to.y != from.y ? to.y < from.y : to.z < from.z);
+  const glm::vec3& a = swap ? to : from;
+  const glm::vec3& b = swap ? from : to;
   const float len = glm::length(b - a);
   if (!(len > 0.0f)) return false;
   const glm::vec3 dir = (b - a) / len;

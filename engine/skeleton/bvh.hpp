@@ -24,7 +24,8 @@ public:
   // `skip_vertex` are ignored (pass UINT32_MAX to ignore none).
   Hit closest(const glm::vec3& o, const glm::vec3& dir, float tmin, float tmax,
               std::uint32_t skip_vertex = UINT32_MAX) const;
-  // True when the open segment a -> b crosses a triangle (faces using skip_vertex ignored).
+  // True when the open segment a -> b crosses a triangle (faces using skip_vertex ignored);
+  // symmetric: (a, b) and (b, a) give the same answer.
   bool segment_blocked(const glm::vec3& a, const glm::vec3& b,
                        std::uint32_t skip_vertex = UINT32_MAX) const;
   // Inside test for a closed mesh: the majority vote of three rays in fixed skew directions,

@@ -901,7 +901,8 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
       // one end's vertices to the other's (Dijkstra over mesh edges, near the edge: centre points
       // within |ab| of its midpoint; every step between centre points inside), thinned to the
       // farthest visible centre point at each step; each new node takes its vertex from a node
-      // that keeps at least one.
+      // that keeps at least one. Where no such path stays near the edge, the same search over
+      // all the solid's inside centre points (camel's one bridge through the air; s11fix).
       std::vector<std::array<std::uint32_t, 2>> left;
       if (!unrouted.empty()) {
         std::vector<std::vector<std::uint32_t>> vertex_nbrs(n);
@@ -915,11 +916,16 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
           if (centre_in[k] < 0) centre_in[k] = surface.bvh.inside(surface.centre[k]) ? 1 : 0;
           return centre_in[k] == 1;
         };
-        for (const auto& e : unrouted) {
+        // `near_only`: the centre points within |ab| of the edge's midpoint (a local detour);
+        // without it, any inside centre point (the whole solid's, for an edge that the local
+        // search could not route round a deep concavity: camel, bones).
+        auto route_chain = [&](const std::array<std::uint32_t, 2>& e, bool near_only) {
           const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
           const glm::vec3 mid = 0.5f * (pa + pb);
           const float reach = glm::length(pb - pa);
-          auto near = [&](std::uint32_t k) { return glm::length(surface.centre[k] - mid) <= reach && inside_centre(k); };
+          auto near = [&](std::uint32_t k) {
+            return (!near_only || glm::length(surface.centre[k] - mid) <= reach) && inside_centre(k);
+          };
           std::map<std::uint32_t, float> dist;
           std::map<std::uint32_t, std::uint32_t> from;
           using Item = std::pair<float, std::uint32_t>;
@@ -932,7 +938,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
             }
           std::uint32_t reached = UINT32_MAX;
           std::size_t settled = 0;
-          while (!queue.empty() && settled < 20000) {
+          while (!queue.empty() && settled < (near_only ? std::size_t{20000} : n)) {
             const auto [d, k] = queue.top();
             queue.pop();
             if (d > dist[k]) continue;
@@ -952,10 +958,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
               }
             }
           }
-          if (reached == UINT32_MAX) {
-            left.push_back(e);
-            continue;
-          }
+          if (reached == UINT32_MAX) return false;
           std::vector<std::uint32_t> path;
           for (std::uint32_t k = reached; k != UINT32_MAX; k = from[k]) path.push_back(k);
           std::reverse(path.begin(), path.end());
@@ -977,10 +980,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
             if (node == UINT32_MAX || sk.nodes[node].vertices.size() < 2 + taken[node]) ok = false;
             ++taken[node];
           }
-          if (!ok) {
-            left.push_back(e);
-            continue;
-          }
+          if (!ok) return false;
           std::uint32_t previous = e[0];
           for (std::uint32_t k : waypoints) {
             std::erase(sk.nodes[node_of_vertex[k]].vertices, k);
@@ -995,7 +995,10 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
             previous = id;
           }
           add_edge(previous, e[1]);
-        }
+          return true;
+        };
+        for (const auto& e : unrouted)
+          if (!route_chain(e, true) && !route_chain(e, false)) left.push_back(e);
         log_debug("skeleton: " + std::to_string(unrouted.size() - left.size()) + " of " +
                   std::to_string(unrouted.size()) + " edges re-routed along centre points");
       }
