@@ -902,7 +902,9 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
       // within |ab| of its midpoint; every step between centre points inside), thinned to the
       // farthest visible centre point at each step; each new node takes its vertex from a node
       // that keeps at least one. Where no such path stays near the edge, the same search over
-      // all the solid's inside centre points (camel's one bridge through the air; s11fix).
+      // all the solid's inside centre points, from either end (a search seeded at one end can
+      // be walled in where the other's is not: camel's one bridge through the air, mpi's sheet
+      // links; s11fix).
       std::vector<std::array<std::uint32_t, 2>> left;
       if (!unrouted.empty()) {
         std::vector<std::vector<std::uint32_t>> vertex_nbrs(n);
@@ -998,7 +1000,7 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
           return true;
         };
         for (const auto& e : unrouted)
-          if (!route_chain(e, true) && !route_chain(e, false)) left.push_back(e);
+          if (!route_chain(e, true) && !route_chain(e, false) && !route_chain({e[1], e[0]}, false)) left.push_back(e);
         log_debug("skeleton: " + std::to_string(unrouted.size() - left.size()) + " of " +
                   std::to_string(unrouted.size()) + " edges re-routed along centre points");
       }
