@@ -3,6 +3,7 @@
 struct Chart {
   uvec4 rect;    // x0, y0, width, height (texels)
   uvec4 params;  // box radii 0, 1, 2 of the blur; wraps_x
+  vec4 metric;   // x: the chart's mean model units per texel
 };
 
 // The blurred texel buffers are tiled: 64 x 64 texel tiles, row-major inside a tile and tiles

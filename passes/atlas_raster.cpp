@@ -1,14 +1,17 @@
 // Atlas raster pass: the mapping's triangles, one value per corner, into an RG32F atlas
-// (value, coverage) cleared to zero (glsl/atlas_raster.*), then copied into the texel buffer the
-// blur works on. Fragments outside their triangle's chart rectangle are discarded in the shader.
+// (value, coverage) and an RG32F stretch target (the triangle's model units per texel along x
+// and y), both cleared to zero (glsl/atlas_raster.*), then copied into the buffers the blur works
+// on. Fragments outside their triangle's chart rectangle are discarded in the shader.
 #include "atlas_passes.hpp"
 
 namespace sdfkit::diffusion::passes {
 
-vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& in) {
+AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& in) {
   constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   auto raster = graph.add_pass("atlas.raster", vk::PassKind::Graphics);
-  const vk::ImageHandle target = raster.color(in.target, vk::LoadOp::Clear, VkClearColorValue{{0.0f, 0.0f, 0.0f, 0.0f}});
+  const VkClearColorValue zero{{0.0f, 0.0f, 0.0f, 0.0f}};
+  const vk::ImageHandle target = raster.color(in.target, vk::LoadOp::Clear, zero);
+  const vk::ImageHandle stretch_target = raster.color(in.stretch_target, vk::LoadOp::Clear, zero);
   raster.vertex(in.vertices);
   raster.storage_read(in.charts);
   raster.execute([in](vk::PassContext& pc) {
@@ -24,17 +27,23 @@ vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaster
     vkCmdDraw(pc.cmd, in.vertex_count, 1, 0, 0);
   });
 
-  auto copy = graph.add_pass("atlas.raster.copy", vk::PassKind::Transfer);
-  copy.transfer_src(target);
-  const vk::BufferHandle texels = copy.transfer_dst(in.texels);
-  copy.execute([target, texels, size = in.size](vk::PassContext& pc) {
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {size, size, 1};
-    vkCmdCopyImageToBuffer(pc.cmd, pc.image(target), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.buffer(texels), 1,
-                           &region);
-  });
-  return texels;
+  // One copy pass per target (image -> row-major buffer).
+  const auto copy_out = [&](const char* name, vk::ImageHandle image, vk::BufferHandle buffer) {
+    auto copy = graph.add_pass(name, vk::PassKind::Transfer);
+    copy.transfer_src(image);
+    const vk::BufferHandle out = copy.transfer_dst(buffer);
+    copy.execute([image, out, size = in.size](vk::PassContext& pc) {
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.imageExtent = {size, size, 1};
+      vkCmdCopyImageToBuffer(pc.cmd, pc.image(image), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.buffer(out), 1, &region);
+    });
+    return out;
+  };
+  AtlasRasterOutput out;
+  out.texels = copy_out("atlas.raster.copy", target, in.texels);
+  out.stretch = copy_out("atlas.raster.stretch_copy", stretch_target, in.stretch);
+  return out;
 }
 
 }  // namespace sdfkit::diffusion::passes
