@@ -2,24 +2,21 @@
 // Atlas blur, stretch-compensated (texture-space diffusion's "stretch maps"): one box filter of
 // the Gaussian's cascade along one axis per dispatch, like atlas_blur_box.comp, but the box's
 // width is chosen per output texel from the local metric of the chart's map there: the raster
-// pass's stretch buffer gives each texel's model units per texel m along the axis (that of the
-// triangle covering it; the chart's mean where none does), so the box's variance is
-// (variance / m² - 1/6) / 3 texels² (a third of the Gaussian's variance in model units, less the
-// bilinear read-back's 1/6 texel²): a blur of one width in model units wherever the chart's map
-// stretches or shrinks the surface (a bone chart's angle direction scales with the radius around
-// the bone, planar and cap charts stretch towards their rims), instead of one width in texels
-// per chart.
+// pass turned each triangle's model units per texel m along x and y into the box half-widths
+// h = f + a there (stretch_half_width in atlas_common.glsl: a third of variance / m² less the
+// bilinear read-back's 1/6 texel² per box, fractional ends so the width changes smoothly), -1
+// where no triangle drew (then the chart's mean scale's). So the blur is one width in model units
+// wherever the chart's map stretches or shrinks the surface (a bone chart's angle direction
+// scales with the radius around the bone, planar and cap charts stretch towards their rims),
+// instead of one width in texels per chart. The three boxes share the widths.
 //
-// A box of half-width h = f + a (f integer, 0 <= a < 1) has weights 1 on |k| <= f and a on
-// |k| = f + 1: total 2f + 1 + 2a, variance (f (f+1)(2f+1)/3 + 2a (f+1)²) / (2f + 1 + 2a), which
-// is continuous and increasing in h, so a is solved in closed form for the wanted variance and
-// the width changes smoothly along the line. One invocation per job = one row (axis 0) or column
-// (axis 1) of one chart, walked with a running sum over the integer window [lo, hi] whose ends
-// move to i - f and i + f at each texel (one read per step of an end, so about two reads per
-// texel however wide the window, as the fixed-width cascade), plus the two fractional end
-// texels, kept beside the sum. Both channels (value · coverage, coverage) are blurred; outside
-// the chart's rectangle there are zeros (rows of a wrapping chart wrap instead, the window never
-// wider than the row), so nothing enters from another chart or the gutter.
+// One invocation per job = one row (axis 0) or column (axis 1) of one chart, walked with a
+// running sum over the integer window [lo, hi] whose ends move to i - f and i + f at each texel
+// (one read per step of an end, so about two reads per texel however wide the window, as the
+// fixed-width cascade), plus the two fractional end texels, kept beside the sum. Both channels
+// (value · coverage, coverage) are blurred; outside the chart's rectangle there are zeros (rows of
+// a wrapping chart wrap instead, the window never wider than the row), so nothing enters from
+// another chart or the gutter.
 #extension GL_GOOGLE_include_directive : require
 #include "atlas_common.glsl"
 
@@ -29,7 +26,7 @@ layout(std430, binding = 0) readonly buffer Jobs { uvec2 jobs[]; };  // chart, l
 layout(std430, binding = 1) readonly buffer Charts { Chart charts[]; };
 layout(std430, binding = 2) readonly buffer Src { vec2 src[]; };
 layout(std430, binding = 3) writeonly buffer Dst { vec2 dst[]; };
-layout(std430, binding = 4) readonly buffer Stretch { vec2 stretch[]; };  // row-major, model units per texel along x, y
+layout(std430, binding = 4) readonly buffer HalfWidths { vec2 half_widths[]; };  // row-major, along x, y; -1: none drawn
 
 layout(push_constant) uniform Push {
   uint job_offset;
@@ -45,15 +42,16 @@ uvec2 g_origin;  // the line's first texel
 uvec2 g_step;    // (1, 0) along a row, (0, 1) along a column
 int g_n;
 bool g_wrap;
-float g_mean_metric;  // the chart's model units per texel, where no triangle gave one
+float g_fallback;  // the half-width at the chart's mean scale, where no triangle drew one
+int g_cap;        // the largest integer half-width: the line (a wrapping row: half of it)
 
 uint src_index(uvec2 p) { return pc.src_tiled != 0u ? tiled_index(p.x, p.y, pc.size) : p.y * pc.size + p.x; }
 
-// Texel k of the line: rows of wrapping charts wrap, elsewhere zeros outside.
+// Texel k of the line: rows of wrapping charts wrap (the window and its fractional ends stay
+// within one period of the line, so one shift suffices), elsewhere zeros outside.
 vec2 fetch(int k) {
   if (g_wrap) {
-    k = k % g_n;
-    if (k < 0) k += g_n;
+    k = k < 0 ? k + g_n : (k >= g_n ? k - g_n : k);
   } else if (k < 0 || k >= g_n) {
     return vec2(0.0);
   }
@@ -63,23 +61,13 @@ vec2 fetch(int k) {
 // The box's half-width at texel i of the line: (f, a).
 void half_width(int i, out int f, out float a) {
   const uvec2 p = g_origin + uint(i) * g_step;
-  float m = stretch[p.y * pc.size + p.x][pc.axis];
-  if (!(m > 0.0) || isinf(m)) m = g_mean_metric;
-  // Per box a third of the Gaussian's variance in texels², never wider than the line.
-  const float n = float(g_n);
-  const float v = clamp((pc.variance / (m * m) - 1.0 / 6.0) / 3.0, 0.0, n * n);
-  f = int(floor(0.5 * (sqrt(1.0 + 12.0 * v) - 1.0)));
-  // Rounding of the square root: the largest f with f (f + 1) / 3 <= v.
-  if (float(f * (f + 1)) > 3.0 * v) --f;
-  if (float((f + 1) * (f + 2)) <= 3.0 * v) ++f;
-  f = max(f, 0);
-  const float ff = float(f);
-  a = (2.0 * ff + 1.0) * (v - ff * (ff + 1.0) / 3.0) / (2.0 * ((ff + 1.0) * (ff + 1.0) - v));
-  a = clamp(a, 0.0, 1.0);
+  float h = half_widths[p.y * pc.size + p.x][pc.axis];
+  if (h < 0.0) h = g_fallback;
+  f = int(h);
+  a = h - float(f);
   // A wrapping row: the window and its fractional ends stay within one period.
-  const int cap = g_wrap ? (g_n - 1) / 2 : g_n;
-  if (f >= cap || (g_wrap && f + 1 > cap && a > 0.0)) {
-    f = min(f, cap);
+  if (f >= g_cap || (g_wrap && f + 1 > g_cap && a > 0.0)) {
+    f = min(f, g_cap);
     a = 0.0;
   }
 }
@@ -100,7 +88,8 @@ void main() {
     g_n = int(c.rect.w);
     g_wrap = false;
   }
-  g_mean_metric = c.metric.x;
+  g_fallback = max(stretch_half_width(c.metric.x, pc.variance), 0.0);
+  g_cap = g_wrap ? (g_n - 1) / 2 : g_n;
   // The window [lo, hi], its sum, its end texels (xl, xh) and the texels just outside (xl1 at
   // lo - 1, xh1 at hi + 1): each step of an end reads one texel.
   int f;

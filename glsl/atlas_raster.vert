@@ -7,7 +7,7 @@ layout(location = 2) in uint in_chart;
 layout(location = 3) in vec2 in_stretch;  // model units per texel along x, y (the triangle's)
 
 layout(push_constant) uniform Push {
-  vec4 scale;  // x: 2 / atlas size
+  vec4 scale;  // x: 2 / atlas size, y: the blur's variance (the fragment stage's)
 } pc;
 
 layout(location = 0) out float out_value;

@@ -50,8 +50,8 @@ struct SampleRange {
 };
 static_assert(sizeof(SampleRange) == 16);
 
-struct RasterPush {  // atlas_raster.vert
-  glm::vec4 scale;   // x: 2 / atlas size
+struct RasterPush {  // atlas_raster.vert, atlas_raster.frag
+  glm::vec4 scale;   // x: 2 / atlas size, y: the stretch-compensated blur's variance (model units²)
 };
 struct BlurPush {    // atlas_blur.comp, atlas_blur_box.comp
   std::uint32_t job_offset, job_count, size, axis, box, src_tiled;
@@ -74,14 +74,17 @@ struct DilatePush {  // atlas_dilate.comp
 };
 
 // Rasterizes `vertex_count` RasterVertex corners into `target` (RG32F, cleared to 0: value,
-// coverage) and `stretch_target` (RG32F, cleared to 0: each covering triangle's model units per
-// texel along x and y) and copies them into `texels` and `stretch` (size² vec2, row-major).
-// Returns the written buffers.
+// coverage) and `stretch_target` (RG32F, cleared to -1: the stretch-compensated blur's box
+// half-widths along x and y for `variance`, from the covering triangle's stretch;
+// glsl/atlas_common.glsl stretch_half_width) and copies them into `texels` and `stretch` (size²
+// vec2, row-major). Returns the written buffers (nothing reads `stretch` in a radius blur: the
+// graph culls its copy).
 struct AtlasRasterPass {
   const vk::Pipeline* pipeline = nullptr;
   vk::ImageHandle target, stretch_target;
   vk::BufferHandle vertices, charts, texels, stretch;
   std::uint32_t vertex_count = 0, size = 0;
+  float variance = 0.0f;  // model units², as AtlasBlurPass::variance
 };
 struct AtlasRasterOutput {
   vk::BufferHandle texels, stretch;
@@ -101,8 +104,9 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
 //
 // Stretch-compensated (`stretch_pipeline` set, glsl/atlas_blur_stretch.comp, every line in the
 // cascade, no fused lines): each box's width is chosen per output texel from the raster pass's
-// `stretch` (model units per texel along the axis there), so that the three boxes have the
-// variance `variance` (model units²) in model units wherever the chart's map stretches.
+// `stretch` (the half-widths from the map's model units per texel along the axis there), so that
+// the three boxes have the variance `variance` (model units²) in model units wherever the chart's
+// map stretches.
 struct AtlasBlurPass {
   const vk::Pipeline* pipeline = nullptr;
   const vk::Pipeline* box_pipeline = nullptr;

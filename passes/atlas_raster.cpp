@@ -1,7 +1,7 @@
 // Atlas raster pass: the mapping's triangles, one value per corner, into an RG32F atlas
-// (value, coverage) and an RG32F stretch target (the triangle's model units per texel along x
-// and y), both cleared to zero (glsl/atlas_raster.*), then copied into the buffers the blur works
-// on. Fragments outside their triangle's chart rectangle are discarded in the shader.
+// (value, coverage) cleared to zero and an RG32F target of the stretch-compensated blur's box
+// half-widths along x and y (from the triangle's model units per texel; cleared to -1: none)
+// (glsl/atlas_raster.*), then copied into the buffers the blur works on. Fragments outside their triangle's chart rectangle are discarded in the shader.
 #include "atlas_passes.hpp"
 
 namespace sdfkit::diffusion::passes {
@@ -11,7 +11,8 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
   auto raster = graph.add_pass("atlas.raster", vk::PassKind::Graphics);
   const VkClearColorValue zero{{0.0f, 0.0f, 0.0f, 0.0f}};
   const vk::ImageHandle target = raster.color(in.target, vk::LoadOp::Clear, zero);
-  const vk::ImageHandle stretch_target = raster.color(in.stretch_target, vk::LoadOp::Clear, zero);
+  const vk::ImageHandle stretch_target =
+      raster.color(in.stretch_target, vk::LoadOp::Clear, VkClearColorValue{{-1.0f, -1.0f, 0.0f, 0.0f}});
   raster.vertex(in.vertices);
   raster.storage_read(in.charts);
   raster.execute([in](vk::PassContext& pc) {
@@ -22,7 +23,7 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
     const VkBuffer b = pc.buffer(in.vertices);
     const VkDeviceSize offset = 0;
     vkCmdBindVertexBuffers(pc.cmd, 0, 1, &b, &offset);
-    const RasterPush push{glm::vec4(2.0f / static_cast<float>(in.size), 0.0f, 0.0f, 0.0f)};
+    const RasterPush push{glm::vec4(2.0f / static_cast<float>(in.size), in.variance, 0.0f, 0.0f)};
     vkCmdPushConstants(pc.cmd, in.pipeline->layout.get(), kStages, 0, sizeof(push), &push);
     vkCmdDraw(pc.cmd, in.vertex_count, 1, 0, 0);
   });

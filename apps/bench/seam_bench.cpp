@@ -20,7 +20,11 @@
 // with one width per chart, from the same mapping in the same run (the stretch compensation's
 // own effect), and the summary counts it too.
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--no-blend] [--no-stretch] [--atlas-size N] [--models] [MESH...]
+// --by-kind: after each row, where the error sits: per chart kind (bone, joint, sheet) of the
+// vertices' own charts, their share of the vertices, the RMS of texture space and of k-ring
+// against heat over them, and the kind's share of texture space's squared error.
+//
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--no-blend] [--no-stretch] [--by-kind] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -53,7 +57,7 @@ int main(int argc, char** argv) {
   CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
   std::vector<std::string> meshes;
   std::vector<float> sigmas;
-  bool no_band = false, no_blend = false, no_stretch = false;
+  bool no_band = false, no_blend = false, no_stretch = false, by_kind = false;
   std::uint32_t atlas_size = 2048;
   bool models = false;
   app.add_option("meshes", meshes, "Mesh files (closed)")->check(CLI::ExistingFile);
@@ -63,6 +67,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
   app.add_flag("--no-blend", no_blend, "Every vertex read back from its own chart only (no blend over the charts covering it)");
   app.add_flag("--no-stretch", no_stretch, "One blur width in texels per chart (its mean scale) instead of one per texel from the map's local stretch");
+  app.add_flag("--by-kind", by_kind, "After each row, the error against heat per chart kind (bone, joint, sheet)");
   app.add_option("--atlas-size", atlas_size, "Atlas size in texels")->check(CLI::Range(16, 16384));
   CLI11_PARSE(app, argc, argv);
   if (meshes.empty() && !models) {
@@ -146,6 +151,30 @@ int main(int argc, char** argv) {
                       c.pearson, 100.0 * c.median_relative, rms, krms, ko.rings, krms > 0 ? rms / krms : 0.0,
                       krms > 0 ? rms1 / krms : 0.0, 100.0 * stm.quality.overlap, stm.quality.seconds);
           summary[si].texk_per_chart.push_back(krms > 0 ? rms1 / krms : 0.0);
+          if (by_kind) {
+            // Squared errors of texture space and k-ring against heat, summed per kind of the
+            // vertex's own chart.
+            double tex2[3] = {}, k2[3] = {}, all = 0.0;
+            std::size_t count[3] = {};
+            for (std::size_t v = 0; v < tex.size(); ++v) {
+              const auto kind = static_cast<std::size_t>(stm.mapping.charts[stm.mapping.vertex_chart[v]].kind);
+              const double dt = static_cast<double>(tex[v]) - heat[v], dk = static_cast<double>(kr[v]) - heat[v];
+              tex2[kind] += dt * dt;
+              k2[kind] += dk * dk;
+              all += dt * dt;
+              ++count[kind];
+            }
+            std::printf("|   by kind | ");
+            const char* names[3] = {"bone", "joint", "sheet"};
+            for (std::size_t k = 0; k < 3; ++k) {
+              if (count[k] == 0) continue;
+              const double n = static_cast<double>(count[k]);
+              std::printf("%s: %.0f %% of vertices, tex rms %.4f, k-ring rms %.4f, %.0f %% of tex error; ", names[k],
+                          100.0 * n / static_cast<double>(tex.size()), std::sqrt(tex2[k] / n), std::sqrt(k2[k] / n),
+                          all > 0 ? 100.0 * tex2[k] / all : 0.0);
+            }
+            std::printf("|\n");
+          }
           summary[si].seam.push_back(ratio);
           summary[si].texk.push_back(krms > 0 ? rms / krms : 0.0);
           summary[si].pearson.push_back(c.pearson);

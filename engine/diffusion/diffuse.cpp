@@ -398,6 +398,9 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   rp.charts = chart_h;
   rp.texels = texels;
   rp.stretch = stretch;
+  const float variance =
+      options.sigma > 0.0f ? static_cast<float>(std::max(static_cast<double>(options.sigma) * options.sigma - interp_variance, 0.0)) : 0.0f;
+  rp.variance = variance;
   rp.vertex_count = static_cast<std::uint32_t>(soup.size());
   rp.size = size;
   const auto rastered = passes::add_atlas_raster_pass(graph, rp);
@@ -408,7 +411,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   if (result.plan.stretch) {
     bp.stretch_pipeline = &impl_->blur_stretch;
     bp.stretch = rastered.stretch;
-    bp.variance = static_cast<float>(std::max(static_cast<double>(options.sigma) * options.sigma - interp_variance, 0.0));
+    bp.variance = variance;
   }
   bp.texels = rastered.texels;
   bp.scratch = scratch;
