@@ -14,6 +14,7 @@
 namespace sdfkit::diffusion::passes {
 
 vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& in) {
+  vk::BufferHandle prefix = in.prefix;
   // One dispatch: `count` jobs from `offset`, reading src, writing a new version of dst. `keep`:
   // dst holds another dispatch's charts that are still needed (a partial write, declared as
   // read-write so that the graph neither culls nor reorders that dispatch).
@@ -35,13 +36,21 @@ vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPa
     p.storage_read(src);
     p.storage_read(in.charts);
     p.storage_read(in.jobs);
-    if (stretched) p.storage_read(in.stretch);
+    // The prefix sums: scratch of every stretched dispatch, which reads only what it wrote there
+    // itself (each line's sums before its boxes), so a write: no earlier content is needed.
+    vk::BufferHandle prefix_out{};
+    if (stretched) {
+      p.storage_read(in.stretch);
+      prefix_out = p.storage_write(prefix);
+      prefix = prefix_out;
+    }
     // Only texels inside this dispatch's charts are written.
     const vk::BufferHandle out = keep ? p.storage_read_write(dst) : p.storage_write(dst);
     p.execute([pipeline, src, out, push, push_bytes, stretched, charts = in.charts, jobs = in.jobs,
-               stretch = in.stretch](vk::PassContext& pc) {
+               stretch = in.stretch, prefix_out](vk::PassContext& pc) {
       const VkDescriptorSet set =
-          stretched ? pc.descriptor_set(pipeline->set_layout.get(), {{0, jobs}, {1, charts}, {2, src}, {3, out}, {4, stretch}})
+          stretched ? pc.descriptor_set(pipeline->set_layout.get(),
+                                        {{0, jobs}, {1, charts}, {2, src}, {3, out}, {4, stretch}, {5, prefix_out}})
                     : pc.descriptor_set(pipeline->set_layout.get(), {{0, jobs}, {1, charts}, {2, src}, {3, out}});
       vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline->get());
       vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline->layout.get(), 0, 1, &set, 0,

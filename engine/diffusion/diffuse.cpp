@@ -159,9 +159,9 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, d
         plan.fused_lines += lines;
         axis_fused[axis] = true;
       } else if (plan.stretch) {
-        // Per box and texel: one read per step of each window end, the stretch (plus the warm-up
-        // and the fractional ends, about the chart-scale window).
-        for (int b = 0; b < 3; ++b) plan.texel_reads += lines * (3 * n + 2ull * r[static_cast<std::size_t>(b)] + 5);
+        // Per box and texel: the prefix walk's read, then the half-width, two prefix sums and the
+        // two fractional end texels, whatever the widths.
+        plan.texel_reads += lines * 3 * 6 * n;
         plan.cascade_lines += lines;
         axis_cascade[axis] = true;
       } else {
@@ -242,7 +242,7 @@ struct Diffuser::Impl {
         raster(make_raster_pipeline(c)),
         blur(make_compute(c, "atlas_blur.comp", 4, sizeof(passes::BlurPush))),
         blur_box(make_compute(c, "atlas_blur_box.comp", 4, sizeof(passes::BlurPush))),
-        blur_stretch(make_compute(c, "atlas_blur_stretch.comp", 5, sizeof(passes::StretchBlurPush))),
+        blur_stretch(make_compute(c, "atlas_blur_stretch.comp", 6, sizeof(passes::StretchBlurPush))),
         sample(make_compute(c, "atlas_sample.comp", 5, sizeof(passes::SamplePush))),
         dilate(make_compute(c, "atlas_dilate.comp", 3, sizeof(passes::DilatePush))),
         transients(c) {}
@@ -411,6 +411,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   if (result.plan.stretch) {
     bp.stretch_pipeline = &impl_->blur_stretch;
     bp.stretch = rastered.stretch;
+    bp.prefix = graph.create_buffer("atlas.prefix", texel_bytes);
     bp.variance = variance;
   }
   bp.texels = rastered.texels;

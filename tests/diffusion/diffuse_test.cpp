@@ -101,8 +101,8 @@ TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   EXPECT_EQ(plan_blur(two, off).fused_lines, 0u);
   EXPECT_EQ(plan_blur(two, off).dispatches, 6u);
   // A sigma in model units: stretch-compensated, every line in the three per-box dispatches per
-  // axis, whose reads (about three per texel and box) do not grow with sigma either; with stretch
-  // off the radius plan's fused lines.
+  // axis, whose reads (six per texel and box: prefix sums) do not grow with sigma either; with
+  // stretch off the radius plan's fused lines.
   DiffuseOptions s1, s32;
   s1.sigma = 0.2f;   // 2 texels at 10 texels per unit
   s32.sigma = 6.4f;  // 64 texels

@@ -102,7 +102,8 @@ struct BlurPlan {
   std::uint64_t fused_lines = 0, cascade_lines = 0;
   std::uint32_t dispatches = 0;    // compute dispatches of the blur: per axis 1 fused + 3 cascade, when used
   std::uint64_t line_jobs = 0;     // rows + columns
-  std::uint64_t texel_reads = 0;   // texels read from storage: fused once per walk, cascade twice per box + warm-up
+  std::uint64_t texel_reads = 0;   // texels read from storage: fused once per walk, cascade twice per box + warm-up,
+                                   // stretch-compensated six per box (prefix walk, half-width, two sums, two ends)
 };
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, double interpolation_variance = 0.0);
 
