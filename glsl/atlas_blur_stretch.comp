@@ -15,9 +15,10 @@
 // buffer, then per texel S(i + f) - S(i - f - 1) plus a times the two texels just outside: a fixed
 // number of reads per texel whatever the widths and however they jump from texel to texel (a
 // window walked with moving ends costs the jumps, which grow with the radius: every triangle
-// border in a chart carries a different stretch). Float prefix sums over a line of n texels lose
-// about n · 2^-24 of the line's total in a window's sum (2048 texels: ~1e-4 of a texel's value at
-// the smallest window), far below the blur's own differences from heat flow. Both channels
+// border in a chart carries a different stretch). Each S is kept as two floats, the compensated
+// sum and its compensation (hi + lo), and a window is (hi_b - hi_a) + (lo_b - lo_a): a plain float
+// prefix would lose about n · 2^-24 of the line's total in every window's sum (a constant 2.5
+// through the camel's atlas read back 1e-5 off), this the window's own rounding. Both channels
 // (value · coverage, coverage) are blurred; outside the chart's rectangle there are zeros (rows of
 // a wrapping chart wrap instead, the window never wider than the row, S continued by the row's
 // total per period), so nothing enters from another chart or the gutter.
@@ -31,7 +32,7 @@ layout(std430, binding = 1) readonly buffer Charts { Chart charts[]; };
 layout(std430, binding = 2) readonly buffer Src { vec2 src[]; };
 layout(std430, binding = 3) writeonly buffer Dst { vec2 dst[]; };
 layout(std430, binding = 4) readonly buffer HalfWidths { vec2 half_widths[]; };  // row-major, along x, y; -1: none drawn
-layout(std430, binding = 5) buffer Prefix { vec2 prefix[]; };  // tiled like dst: the line's prefix sums
+layout(std430, binding = 5) buffer Prefix { vec4 prefix[]; };  // tiled like dst: the line's prefix sums, (hi, lo)
 
 layout(push_constant) uniform Push {
   uint job_offset;
@@ -47,7 +48,7 @@ uvec2 g_origin;  // the line's first texel
 uvec2 g_step;    // (1, 0) along a row, (0, 1) along a column
 int g_n;
 bool g_wrap;
-vec2 g_total;     // the line's sum (S continues by it per period of a wrapping row)
+vec4 g_total;     // the line's sum, (hi, lo) (S continues by it per period of a wrapping row)
 float g_fallback;  // the half-width at the chart's mean scale, where no triangle drew one
 int g_cap;        // the largest integer half-width: the line (a wrapping row: half of it)
 
@@ -64,10 +65,11 @@ vec2 fetch(int k) {
   return src[src_index(g_origin + uint(k) * g_step)];
 }
 
-// S(k): the sum of the line's texels up to k; zeros outside a plain line, a wrapping row
-// continued periodically (k within one period either side: the window never wider than the row).
-vec2 prefix_sum(int k) {
-  vec2 shift = vec2(0.0);
+// S(k) as (hi, lo): the sum of the line's texels up to k; zeros outside a plain line, a wrapping
+// row continued periodically (k within one period either side: the window never wider than the
+// row).
+vec4 prefix_sum(int k) {
+  vec4 shift = vec4(0.0);
   if (g_wrap) {
     if (k < 0) {
       k += g_n;
@@ -77,7 +79,7 @@ vec2 prefix_sum(int k) {
       shift = g_total;
     }
   } else {
-    if (k < 0) return vec2(0.0);
+    if (k < 0) return vec4(0.0);
     k = min(k, g_n - 1);
   }
   const uvec2 o = g_origin + uint(k) * g_step;
@@ -116,23 +118,26 @@ void main() {
   }
   g_fallback = max(stretch_half_width(c.metric.x, pc.variance), 0.0);
   g_cap = g_wrap ? (g_n - 1) / 2 : g_n;
-  // Walk 1: S(k) = sum of the line's texels 0..k, compensated.
-  vec2 sum = vec2(0.0), comp = vec2(0.0);
+  // Walk 1: S(k) = sum of the line's texels 0..k, compensated: sum - comp is the exact sum to
+  // second order, stored as (sum, -comp).
+  // `precise`: the compiler must not simplify (t - sum) - y to 0.
+  precise vec2 sum = vec2(0.0), comp = vec2(0.0);
   for (int k = 0; k < g_n; ++k) {
-    const vec2 y = src[src_index(g_origin + uint(k) * g_step)] - comp;
-    const vec2 t = sum + y;
+    precise const vec2 y = src[src_index(g_origin + uint(k) * g_step)] - comp;
+    precise const vec2 t = sum + y;
     comp = (t - sum) - y;
     sum = t;
     const uvec2 o = g_origin + uint(k) * g_step;
-    prefix[tiled_index(o.x, o.y, pc.size)] = sum;
+    prefix[tiled_index(o.x, o.y, pc.size)] = vec4(sum, -comp);
   }
-  g_total = sum;
+  g_total = vec4(sum, -comp);
   // Walk 2: each texel's box from two prefix sums and the two fractional end texels.
   for (int i = 0; i < g_n; ++i) {
     int f;
     float a;
     half_width(i, f, a);
-    const vec2 window = prefix_sum(i + f) - prefix_sum(i - f - 1);
+    precise const vec4 d = prefix_sum(i + f) - prefix_sum(i - f - 1);
+    precise const vec2 window = d.xy + d.zw;
     const uvec2 p = g_origin + uint(i) * g_step;
     dst[tiled_index(p.x, p.y, pc.size)] = (window + a * (fetch(i - f - 1) + fetch(i + f + 1))) / (2.0 * float(f) + 1.0 + 2.0 * a);
   }

@@ -112,7 +112,7 @@ struct AtlasBlurPass {
   const vk::Pipeline* box_pipeline = nullptr;
   const vk::Pipeline* stretch_pipeline = nullptr;
   vk::BufferHandle texels, scratch, charts, jobs, stretch;
-  vk::BufferHandle prefix;  // stretch-compensated: the lines' prefix sums (tiled_texel_bytes)
+  vk::BufferHandle prefix;  // stretch-compensated: the lines' prefix sums, vec4 (hi, lo) per texel (2 · tiled_texel_bytes)
   std::uint32_t rows_fused = 0, rows_cascade = 0, columns_fused = 0, columns_cascade = 0, size = 0;
   float variance = 0.0f;
 };

@@ -276,6 +276,10 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   DiffuseResult result;
   const double interp_variance = options.sigma > 0.0f ? interpolation_variance(mesh) : 0.0;
   result.plan = plan_blur(mapping, options, interp_variance);
+  // The stretch blur's prefix sums take two texel buffers' bytes (vec4 per texel).
+  if (result.plan.stretch && ctx.capabilities().max_storage_buffer_range &&
+      2 * texel_bytes > ctx.capabilities().max_storage_buffer_range)
+    throw DeviceError("a " + std::to_string(size) + "² atlas is larger than the device allows for the stretch-compensated blur's prefix sums");
 
   // Chart table.
   std::vector<passes::GpuChart> charts;
@@ -411,7 +415,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   if (result.plan.stretch) {
     bp.stretch_pipeline = &impl_->blur_stretch;
     bp.stretch = rastered.stretch;
-    bp.prefix = graph.create_buffer("atlas.prefix", texel_bytes);
+    bp.prefix = graph.create_buffer("atlas.prefix", 2 * texel_bytes);  // vec4 per texel: (hi, lo)
     bp.variance = variance;
   }
   bp.texels = rastered.texels;

@@ -13,7 +13,9 @@
 //                 texel is the same at every radius. Rows of a wrapping chart wrap; outside its
 //                 rectangle a chart sees zeros, and both channels are blurred, so the value read
 //                 back is blur(value·coverage) / blur(coverage) (normalized convolution): nothing
-//                 from another chart, from the gutter or from uncovered texels ever comes in
+//                 from another chart, from the gutter or from uncovered texels ever comes in.
+//                 With a sigma, each box's width is per texel (the stretch buffer), each box from
+//                 the line's prefix sums (three compute passes per axis)
 //   atlas_sample  per vertex, bilinear at vertex_uv inside the vertex's chart, normalized; with
 //                 AtlasMapping::samples, the weighted blend of such reads in every chart covering
 //                 the vertex (build_stm's partition of unity across chart borders)
