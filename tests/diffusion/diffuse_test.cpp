@@ -468,6 +468,67 @@ TEST_F(Diffuse, TheRoadAroundTheBlurAddsTheDerivedVariance) {
   }
 }
 
+// The stretch buffer's two axes: the same flat grid through a chart that scales x and y
+// differently (1.37 and 2.9 texels per unit, the chart's mean 2 between). A Gaussian blur of
+// u = x² adds the variance along x, of u = y² the variance along y; with the stretch
+// compensation both are the requested sigma² within 1 % (each axis's box widths come from its own
+// column of the map's Jacobian; measured 4.0022 and 3.9975 for 4), where one width per chart at
+// the mean scale is off by about the squared ratio of the scales on each axis (measured 8.07 and
+// 1.93).
+TEST_F(Diffuse, StretchCompensationUsesEachAxisOwnScale) {
+  const int n = 34;
+  Mesh m;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) m.positions.push_back({static_cast<float>(i), static_cast<float>(j), 0.0f});
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const auto v = static_cast<std::uint32_t>(j * n + i), w = static_cast<std::uint32_t>(n);
+      m.triangles.push_back({v, v + 1, v + w + 1});
+      m.triangles.push_back({v, v + w + 1, v + w});
+    }
+  const float sx = 1.37f, sy = 2.9f;
+  AtlasMapping a;
+  a.size = 128;
+  a.gutter = 2;
+  a.charts.push_back({Chart::Kind::Joint, 2, 2, static_cast<std::uint32_t>(std::ceil((n - 1) * sx)) + 1,
+                      static_cast<std::uint32_t>(std::ceil((n - 1) * sy)) + 1, false, 2.0f});
+  const auto uv = [&](glm::vec3 p) { return glm::vec2(2.5f + p.x * sx, 2.5f + p.y * sy); };
+  for (std::uint32_t f = 0; f < m.triangles.size(); ++f)
+    a.triangles.push_back({0, f, {uv(m.positions[m.triangles[f][0]]), uv(m.positions[m.triangles[f][1]]), uv(m.positions[m.triangles[f][2]])}});
+  a.vertex_chart.assign(m.positions.size(), 0);
+  for (const glm::vec3& p : m.positions) a.vertex_uv.push_back(uv(p));
+  const float c = (n - 1) / 2.0f, sigma = 2.0f;
+  std::vector<float> ux, uy;
+  for (const glm::vec3& p : m.positions) {
+    ux.push_back((p.x - c) * (p.x - c));
+    uy.push_back((p.y - c) * (p.y - c));
+  }
+  // The road's variance along one axis: read-back - u away from the borders (u = x² or y²).
+  const auto variance = [&](const std::vector<float>& u, bool stretch) {
+    DiffuseOptions o = sigma_of(sigma);
+    o.stretch = stretch;
+    const DiffuseResult r = diffuser_->run(m, a, u, o);
+    double sum = 0.0;
+    int count = 0;
+    const float margin = 4.0f * sigma + 1.0f;
+    for (std::size_t v = 0; v < u.size(); ++v) {
+      const glm::vec3 p = m.positions[v];
+      if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
+      sum += static_cast<double>(r.values[v]) - u[v];
+      ++count;
+    }
+    EXPECT_GT(count, 50);
+    return sum / std::max(count, 1);
+  };
+  const double s2 = sigma * sigma;
+  const double vx = variance(ux, true), vy = variance(uy, true), fx = variance(ux, false), fy = variance(uy, false);
+  EXPECT_NEAR(vx, s2, 0.01 * s2);
+  EXPECT_NEAR(vy, s2, 0.01 * s2);
+  EXPECT_GT(std::abs(fx - s2), 0.1 * s2);
+  EXPECT_GT(std::abs(fy - s2), 0.1 * s2);
+  std::printf("sigma² %.3f: stretch-compensated variance along x %.4f, y %.4f; one width per chart %.4f, %.4f\n", s2, vx, vy, fx, fy);
+}
+
 // smooth_texture_space builds the mapping with the band the blur needs: kBandSigmas sigma with
 // sigma in model units; with a radius in texels, at least kBandSigmas radius / texels_per_unit at
 // the atlas scale the band itself gives (the bands shrink the scale).
