@@ -4,16 +4,19 @@
 layout(location = 0) in vec2 in_uv;
 layout(location = 1) in float in_value;
 layout(location = 2) in uint in_chart;
+layout(location = 3) in vec2 in_stretch;  // model units per texel along x, y (the triangle's)
 
 layout(push_constant) uniform Push {
-  vec4 scale;  // x: 2 / atlas size
+  vec4 scale;  // x: 2 / atlas size, y: the blur's variance (the fragment stage's)
 } pc;
 
 layout(location = 0) out float out_value;
 layout(location = 1) flat out uint out_chart;
+layout(location = 2) flat out vec2 out_stretch;
 
 void main() {
   gl_Position = vec4(in_uv * pc.scale.x - 1.0, 0.0, 1.0);
   out_value = in_value;
   out_chart = in_chart;
+  out_stretch = in_stretch;
 }

@@ -3,6 +3,9 @@
 // on the radius; the radii are the chart table's. Per axis: one fused dispatch (glsl/atlas_blur.comp,
 // the three boxes in one walk) over the lines plan_blur gave it, and three cascade dispatches
 // (glsl/atlas_blur_box.comp, one per box) over the others; both end the axis in the same buffer.
+// Stretch-compensated (AtlasBlurPass::stretch_pipeline): the cascade's three dispatches per axis
+// over every line, each box's width per texel from the raster pass's stretch buffer
+// (glsl/atlas_blur_stretch.comp).
 #include "atlas_passes.hpp"
 
 #include <string>
@@ -11,38 +14,55 @@
 namespace sdfkit::diffusion::passes {
 
 vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& in) {
+  vk::BufferHandle prefix = in.prefix;
   // One dispatch: `count` jobs from `offset`, reading src, writing a new version of dst. `keep`:
   // dst holds another dispatch's charts that are still needed (a partial write, declared as
   // read-write so that the graph neither culls nor reorders that dispatch).
   const auto dispatch = [&](const std::string& name, const vk::Pipeline* pipeline, std::uint32_t axis,
                             std::uint32_t box, bool src_tiled, std::uint32_t offset, std::uint32_t count,
                             vk::BufferHandle src, vk::BufferHandle dst, bool keep) {
-    BlurPush push{};
+    // The stretch shader's push block is BlurPush's with the variance after it.
+    StretchBlurPush push{};
     push.job_offset = offset;
     push.job_count = count;
     push.size = in.size;
     push.axis = axis;
     push.box = box;
     push.src_tiled = src_tiled ? 1u : 0u;
+    push.variance = in.variance;
+    const bool stretched = pipeline == in.stretch_pipeline;
+    const std::uint32_t push_bytes = stretched ? sizeof(StretchBlurPush) : sizeof(BlurPush);
     auto p = graph.add_pass(name, vk::PassKind::Compute);
     p.storage_read(src);
     p.storage_read(in.charts);
     p.storage_read(in.jobs);
+    // The prefix sums: scratch of every stretched dispatch, which reads only what it wrote there
+    // itself (each line's sums before its boxes), so a write: no earlier content is needed.
+    vk::BufferHandle prefix_out{};
+    if (stretched) {
+      p.storage_read(in.stretch);
+      prefix_out = p.storage_write(prefix);
+      prefix = prefix_out;
+    }
     // Only texels inside this dispatch's charts are written.
     const vk::BufferHandle out = keep ? p.storage_read_write(dst) : p.storage_write(dst);
-    p.execute([pipeline, src, out, push, charts = in.charts, jobs = in.jobs](vk::PassContext& pc) {
-      const VkDescriptorSet set = pc.descriptor_set(pipeline->set_layout.get(),
-                                                    {{0, jobs}, {1, charts}, {2, src}, {3, out}});
+    p.execute([pipeline, src, out, push, push_bytes, stretched, charts = in.charts, jobs = in.jobs,
+               stretch = in.stretch, prefix_out](vk::PassContext& pc) {
+      const VkDescriptorSet set =
+          stretched ? pc.descriptor_set(pipeline->set_layout.get(),
+                                        {{0, jobs}, {1, charts}, {2, src}, {3, out}, {4, stretch}, {5, prefix_out}})
+                    : pc.descriptor_set(pipeline->set_layout.get(), {{0, jobs}, {1, charts}, {2, src}, {3, out}});
       vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline->get());
       vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline->layout.get(), 0, 1, &set, 0,
                               nullptr);
-      vkCmdPushConstants(pc.cmd, pipeline->layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+      vkCmdPushConstants(pc.cmd, pipeline->layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, &push);
       vkCmdDispatch(pc.cmd, (push.job_count + 63) / 64, 1, 1);
     });
     return out;
   };
   // a: the buffer each axis starts from, b: the one it ends in (x: texels -> scratch, y: back).
   vk::BufferHandle a = in.texels, b = in.scratch;
+  const vk::Pipeline* cascade_pipeline = in.stretch_pipeline ? in.stretch_pipeline : in.box_pipeline;
   std::uint32_t offset = 0;
   for (std::uint32_t axis = 0; axis < 2; ++axis) {
     const std::string name = std::string("atlas.blur.") + (axis == 0 ? "x" : "y");
@@ -56,9 +76,9 @@ vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPa
       // other charts are no longer needed. Box 1's write of a waits for the fused dispatch's read
       // of it (write after read).
       const bool keep = fused > 0;
-      b = dispatch(name + "0", in.box_pipeline, axis, 0, tiled, offset, cascade, a, b, keep);
-      a = dispatch(name + "1", in.box_pipeline, axis, 1, true, offset, cascade, b, a, false);
-      b = dispatch(name + "2", in.box_pipeline, axis, 2, true, offset, cascade, a, b, keep);
+      b = dispatch(name + "0", cascade_pipeline, axis, 0, tiled, offset, cascade, a, b, keep);
+      a = dispatch(name + "1", cascade_pipeline, axis, 1, true, offset, cascade, b, a, false);
+      b = dispatch(name + "2", cascade_pipeline, axis, 2, true, offset, cascade, a, b, keep);
     }
     offset += cascade;
     std::swap(a, b);  // the next axis reads what this one ended in

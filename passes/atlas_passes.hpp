@@ -16,20 +16,24 @@
 namespace sdfkit::diffusion::passes {
 
 // One chart as the shaders see it (std430): rect = x0, y0, width, height (texels);
-// params = the three box radii of the blur, wraps_x.
+// params = the three box radii of the blur, wraps_x; metric.x = the chart's mean model units per
+// texel (1 / texels_per_unit), what the stretch-compensated blur assumes where no triangle drew a
+// stretch.
 struct GpuChart {
   glm::uvec4 rect;
   glm::uvec4 params;
+  glm::vec4 metric;
 };
-static_assert(sizeof(GpuChart) == 32);
+static_assert(sizeof(GpuChart) == 48);
 
 // One corner of a rasterized atlas triangle (atlas_raster.vert's vertex input).
 struct RasterVertex {
   glm::vec2 uv;        // atlas texels
   float value;
   std::uint32_t chart; // fragments outside this chart's rectangle are discarded
+  glm::vec2 stretch;   // the triangle's |dX/du|, |dX/dv|: model units per texel along the atlas's x and y
 };
-static_assert(sizeof(RasterVertex) == 16);
+static_assert(sizeof(RasterVertex) == 24);
 
 // One read of a vertex's value (atlas_sample.comp): AtlasMapping's VertexSample.
 struct SampleQuery {
@@ -46,11 +50,15 @@ struct SampleRange {
 };
 static_assert(sizeof(SampleRange) == 16);
 
-struct RasterPush {  // atlas_raster.vert
-  glm::vec4 scale;   // x: 2 / atlas size
+struct RasterPush {  // atlas_raster.vert, atlas_raster.frag
+  glm::vec4 scale;   // x: 2 / atlas size, y: the stretch-compensated blur's variance (model units²)
 };
-struct BlurPush {    // atlas_blur.comp
+struct BlurPush {    // atlas_blur.comp, atlas_blur_box.comp
   std::uint32_t job_offset, job_count, size, axis, box, src_tiled;
+};
+struct StretchBlurPush {  // atlas_blur_stretch.comp
+  std::uint32_t job_offset, job_count, size, axis, box, src_tiled;
+  float variance;    // the Gaussian's variance per axis left for the blur, model units²
 };
 
 // Bytes of a tiled texel buffer (glsl/atlas_common.glsl: 64² tiles of vec2) of a size² atlas.
@@ -66,14 +74,22 @@ struct DilatePush {  // atlas_dilate.comp
 };
 
 // Rasterizes `vertex_count` RasterVertex corners into `target` (RG32F, cleared to 0: value,
-// coverage) and copies it into `texels` (size² vec2). Returns the written texel buffer.
+// coverage) and `stretch_target` (RG32F, cleared to -1: the stretch-compensated blur's box
+// half-widths along x and y for `variance`, from the covering triangle's stretch;
+// glsl/atlas_common.glsl stretch_half_width) and copies them into `texels` and `stretch` (size²
+// vec2, row-major). Returns the written buffers (nothing reads `stretch` in a radius blur: the
+// graph culls its copy).
 struct AtlasRasterPass {
   const vk::Pipeline* pipeline = nullptr;
-  vk::ImageHandle target;
-  vk::BufferHandle vertices, charts, texels;
+  vk::ImageHandle target, stretch_target;
+  vk::BufferHandle vertices, charts, texels, stretch;
   std::uint32_t vertex_count = 0, size = 0;
+  float variance = 0.0f;  // model units², as AtlasBlurPass::variance
 };
-vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& pass);
+struct AtlasRasterOutput {
+  vk::BufferHandle texels, stretch;
+};
+AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& pass);
 
 // The separable Gaussian: three boxes along x (rows), then three along y (columns), between
 // `texels` (read row-major by the first passes) and `scratch`, both tiled_texel_bytes. Each line
@@ -85,11 +101,20 @@ vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaster
 // ways end each axis in the same buffer, so an axis is a fused dispatch and three cascade
 // dispatches over disjoint charts, each left out when it has no line. Returns the blurred, tiled
 // texel buffer (a version of `texels`).
+//
+// Stretch-compensated (`stretch_pipeline` set, glsl/atlas_blur_stretch.comp, every line in the
+// cascade, no fused lines): each box's width is chosen per output texel from the raster pass's
+// `stretch` (the half-widths from the map's model units per texel along the axis there), so that
+// the three boxes have the variance `variance` (model units²) in model units wherever the chart's
+// map stretches.
 struct AtlasBlurPass {
   const vk::Pipeline* pipeline = nullptr;
   const vk::Pipeline* box_pipeline = nullptr;
-  vk::BufferHandle texels, scratch, charts, jobs;
+  const vk::Pipeline* stretch_pipeline = nullptr;
+  vk::BufferHandle texels, scratch, charts, jobs, stretch;
+  vk::BufferHandle prefix;  // stretch-compensated: the lines' prefix sums, vec4 (hi, lo) per texel (2 · tiled_texel_bytes)
   std::uint32_t rows_fused = 0, rows_cascade = 0, columns_fused = 0, columns_cascade = 0, size = 0;
+  float variance = 0.0f;
 };
 vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& pass);
 // The largest box radius the fused shader's rings hold (glsl/atlas_blur.comp kRing = 256 >=

@@ -1,14 +1,18 @@
 // Atlas raster pass: the mapping's triangles, one value per corner, into an RG32F atlas
-// (value, coverage) cleared to zero (glsl/atlas_raster.*), then copied into the texel buffer the
-// blur works on. Fragments outside their triangle's chart rectangle are discarded in the shader.
+// (value, coverage) cleared to zero and an RG32F target of the stretch-compensated blur's box
+// half-widths along x and y (from the triangle's model units per texel; cleared to -1: none)
+// (glsl/atlas_raster.*), then copied into the buffers the blur works on. Fragments outside their triangle's chart rectangle are discarded in the shader.
 #include "atlas_passes.hpp"
 
 namespace sdfkit::diffusion::passes {
 
-vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& in) {
+AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& in) {
   constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   auto raster = graph.add_pass("atlas.raster", vk::PassKind::Graphics);
-  const vk::ImageHandle target = raster.color(in.target, vk::LoadOp::Clear, VkClearColorValue{{0.0f, 0.0f, 0.0f, 0.0f}});
+  const VkClearColorValue zero{{0.0f, 0.0f, 0.0f, 0.0f}};
+  const vk::ImageHandle target = raster.color(in.target, vk::LoadOp::Clear, zero);
+  const vk::ImageHandle stretch_target =
+      raster.color(in.stretch_target, vk::LoadOp::Clear, VkClearColorValue{{-1.0f, -1.0f, 0.0f, 0.0f}});
   raster.vertex(in.vertices);
   raster.storage_read(in.charts);
   raster.execute([in](vk::PassContext& pc) {
@@ -19,22 +23,28 @@ vk::BufferHandle add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaster
     const VkBuffer b = pc.buffer(in.vertices);
     const VkDeviceSize offset = 0;
     vkCmdBindVertexBuffers(pc.cmd, 0, 1, &b, &offset);
-    const RasterPush push{glm::vec4(2.0f / static_cast<float>(in.size), 0.0f, 0.0f, 0.0f)};
+    const RasterPush push{glm::vec4(2.0f / static_cast<float>(in.size), in.variance, 0.0f, 0.0f)};
     vkCmdPushConstants(pc.cmd, in.pipeline->layout.get(), kStages, 0, sizeof(push), &push);
     vkCmdDraw(pc.cmd, in.vertex_count, 1, 0, 0);
   });
 
-  auto copy = graph.add_pass("atlas.raster.copy", vk::PassKind::Transfer);
-  copy.transfer_src(target);
-  const vk::BufferHandle texels = copy.transfer_dst(in.texels);
-  copy.execute([target, texels, size = in.size](vk::PassContext& pc) {
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {size, size, 1};
-    vkCmdCopyImageToBuffer(pc.cmd, pc.image(target), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.buffer(texels), 1,
-                           &region);
-  });
-  return texels;
+  // One copy pass per target (image -> row-major buffer).
+  const auto copy_out = [&](const char* name, vk::ImageHandle image, vk::BufferHandle buffer) {
+    auto copy = graph.add_pass(name, vk::PassKind::Transfer);
+    copy.transfer_src(image);
+    const vk::BufferHandle out = copy.transfer_dst(buffer);
+    copy.execute([image, out, size = in.size](vk::PassContext& pc) {
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.imageExtent = {size, size, 1};
+      vkCmdCopyImageToBuffer(pc.cmd, pc.image(image), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.buffer(out), 1, &region);
+    });
+    return out;
+  };
+  AtlasRasterOutput out;
+  out.texels = copy_out("atlas.raster.copy", target, in.texels);
+  out.stretch = copy_out("atlas.raster.stretch_copy", stretch_target, in.stretch);
+  return out;
 }
 
 }  // namespace sdfkit::diffusion::passes

@@ -93,12 +93,15 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
      << "blur: the full graph's wall time minus that; read-back: values out of mapped memory; total: diffuse() "
      << "end to end (prepare + graph + read-back); blur, 6-dispatch cascade: the same blur as one dispatch per box "
      << "(DiffuseOptions::fused_blur = false, the form before the fused shader), timed the same way in the same runs; "
+     << "blur, stretch-compensated: the blur of sigma = radius / texels_per_unit (first chart) in model units, whose "
+     << "width follows the map's local stretch per texel (DiffuseOptions::stretch, the default with a sigma: three "
+     << "dispatches per axis), timed the same way; "
      << "CPU ms: the process's CPU time (all threads, lavapipe's included) of the run less that of the run without "
      << "the blur, which a loaded machine inflates far less than wall time. "
      << "lavapipe's timestamps around the blur's dispatches read ~0.1 ms (it records, then runs the whole "
      << "submission), so times here are wall-time differences.\n\n";
-  md << "| mesh | vertices | skeleton s | mapping ms | radius px | prepare ms | raster+sample ms | blur ms | read-back ms | total ms | blur, 6-dispatch cascade ms | blur CPU ms | cascade CPU ms |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  md << "| mesh | vertices | skeleton s | mapping ms | radius px | prepare ms | raster+sample ms | blur ms | read-back ms | total ms | blur, 6-dispatch cascade ms | blur CPU ms | cascade CPU ms | blur, stretch-compensated ms | stretch CPU ms |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   std::ostringstream kmd;
   kmd << "\nk-ring smoothing on the same meshes (engine/post/smooth, all cores):\n\n| mesh | vertices |";
   for (int k : o.rings) kmd << " k=" << k << " ms |";
@@ -141,13 +144,22 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
       diffusion::DiffuseOptions d;
       d.radius_px = radius;
       diffuser.run(bm.mesh, mapping, u, d);  // warm-up
-      std::vector<double> raster, blur, sample, readback, total, unblurred, cascade, cpu_blur, cpu_cascade;
+      std::vector<double> raster, blur, sample, readback, total, unblurred, cascade, cpu_blur, cpu_cascade, stretch, cpu_stretch;
       const auto cpu_ms = [](std::clock_t a, std::clock_t b) { return 1000.0 * static_cast<double>(b - a) / CLOCKS_PER_SEC; };
       diffusion::DiffuseOptions nb = d;
       nb.blur = false;
       diffusion::DiffuseOptions box = d;  // the six-dispatch cascade the fused blur replaced
       box.fused_blur = false;
       diffuser.run(bm.mesh, mapping, u, box);  // warm-up
+      // The stretch-compensated blur of the sigma whose chart-scale width is this radius.
+      diffusion::DiffuseOptions st;
+      st.sigma = mapping.charts.empty() || !(mapping.charts[0].texels_per_unit > 0.0f)
+                     ? 0.0f
+                     : radius / mapping.charts[0].texels_per_unit;
+      diffusion::DiffuseOptions st_nb = st;
+      st_nb.blur = false;
+      const bool with_stretch = st.sigma > 0.0f;
+      if (with_stretch) diffuser.run(bm.mesh, mapping, u, st);  // warm-up
       for (int r = 0; r < o.repeats; ++r) {
         // CPU time of the whole process (lavapipe's worker threads included) beside the wall
         // time: on a shared machine it is what the blur itself cost, whatever else runs.
@@ -166,6 +178,15 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
         c0 = std::clock();
         cascade.push_back(diffuser.run(bm.mesh, mapping, u, box).timings.execute - unblurred.back());
         cpu_cascade.push_back(cpu_ms(c0, std::clock()) - cpu_unblurred);
+        if (with_stretch) {
+          // Its own baseline: the sigma graph without the blur (the raster's stretch target
+          // and copy are then culled, as in the radius graph).
+          c0 = std::clock();
+          const double st_unblurred = diffuser.run(bm.mesh, mapping, u, st_nb).timings.execute;
+          const std::clock_t c3 = std::clock();
+          stretch.push_back(diffuser.run(bm.mesh, mapping, u, st).timings.execute - st_unblurred);
+          cpu_stretch.push_back(cpu_ms(c3, std::clock()) - cpu_ms(c0, c3));
+        }
       }
       nlohmann::json jr;
       jr["radius_px"] = radius;
@@ -175,15 +196,20 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
       jr["blur_cascade_ms"] = median(cascade);
       jr["blur_cpu_ms"] = median(cpu_blur);
       jr["blur_cascade_cpu_ms"] = median(cpu_cascade);
+      if (with_stretch) {
+        jr["stretch_sigma"] = st.sigma;
+        jr["blur_stretch_ms"] = median(stretch);
+        jr["blur_stretch_cpu_ms"] = median(cpu_stretch);
+      }
       jr["blur_dispatches"] = diffusion::plan_blur(mapping, d).dispatches;
       jr["readback_ms"] = median(readback);
       jr["total_ms"] = median(total);
       jm["radii"].push_back(jr);
-      char line[512];
-      std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %.0f |\n",
+      char line[600];
+      std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %.0f | %.1f | %.0f |\n",
                     bm.name.c_str(), bm.mesh.vertex_count(), skeleton_s, mapping_ms, static_cast<double>(radius),
                     median(sample), median(raster), median(blur), median(readback), median(total), median(cascade),
-                    median(cpu_blur), median(cpu_cascade));
+                    median(cpu_blur), median(cpu_cascade), median(stretch), median(cpu_stretch));
       md << line;
     }
     kmd << "| " << bm.name << " | " << bm.mesh.vertex_count() << " |";

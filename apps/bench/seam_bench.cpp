@@ -15,9 +15,16 @@
 // tex/k, and how many meshes meet seam ratio ≤ 1.5, tex/k ≤ 1 and Pearson ≥ 0.95.
 //
 // With the band, each vertex is read back from every chart covering it, blended (StmOptions::blend),
-// unless --no-blend.
+// unless --no-blend. The blur's width follows the charts' local stretch (DiffuseOptions::stretch)
+// unless --no-stretch (one width per chart). The tex/k column "per chart" gives the same ratio
+// with one width per chart, from the same mapping in the same run (the stretch compensation's
+// own effect), and the summary counts it too.
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--no-blend] [--atlas-size N] [--models] [MESH...]
+// --by-kind: after each row, where the error sits: per chart kind (bone, joint, sheet) of the
+// vertices' own charts, their share of the vertices, the RMS of texture space and of k-ring
+// against heat over them, and the kind's share of texture space's squared error.
+//
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--no-blend] [--no-stretch] [--by-kind] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -50,7 +57,7 @@ int main(int argc, char** argv) {
   CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
   std::vector<std::string> meshes;
   std::vector<float> sigmas;
-  bool no_band = false, no_blend = false;
+  bool no_band = false, no_blend = false, no_stretch = false, by_kind = false;
   std::uint32_t atlas_size = 2048;
   bool models = false;
   app.add_option("meshes", meshes, "Mesh files (closed)")->check(CLI::ExistingFile);
@@ -59,6 +66,8 @@ int main(int argc, char** argv) {
   app.add_option("--sigmas", sigma_list, "Sigmas in mean edge lengths, comma separated");
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
   app.add_flag("--no-blend", no_blend, "Every vertex read back from its own chart only (no blend over the charts covering it)");
+  app.add_flag("--no-stretch", no_stretch, "One blur width in texels per chart (its mean scale) instead of one per texel from the map's local stretch");
+  app.add_flag("--by-kind", by_kind, "After each row, the error against heat per chart kind (bone, joint, sheet)");
   app.add_option("--atlas-size", atlas_size, "Atlas size in texels")->check(CLI::Range(16, 16384));
   CLI11_PARSE(app, argc, argv);
   if (meshes.empty() && !models) {
@@ -80,14 +89,15 @@ int main(int argc, char** argv) {
   try {
     vk::Context ctx{vk::ContextConfig{}};
     diffusion::Diffuser diffuser(ctx);
-    std::printf("atlas %u², band %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
+    std::printf("atlas %u², band %s, %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
                 "Against heat diffusion: texture Pearson / median rel. / RMS; k-ring RMS; tex/k = RMS ratio.\n\n",
-                atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back");
+                atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back",
+                no_stretch ? "one blur width per chart" : "stretch-compensated blur");
     std::printf("| mesh | vertices | sigma (edges) | charts | atlas triangles / faces | seam ratio (heat) | pearson | median rel | "
-                "rms | k-ring (k) rms | tex/k | overlap | build_stm s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                "rms | k-ring (k) rms | tex/k | tex/k per chart | overlap | build_stm s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     // Per sigma, over the meshes: seam ratio, tex/k, Pearson (the summary at the end).
     struct Summary {
-      std::vector<double> seam, texk, pearson;
+      std::vector<double> seam, texk, pearson, texk_per_chart;
     };
     std::vector<Summary> summary(sigmas.size());
     std::vector<std::pair<std::string, std::function<Mesh()>>> inputs;
@@ -118,6 +128,7 @@ int main(int argc, char** argv) {
           const diffusion::Stm stm = diffusion::build_stm(m, skel, so);
           diffusion::DiffuseOptions o;
           o.sigma = sigma;
+          o.stretch = !no_stretch;
           const std::vector<float> tex = diffuser.run(m, stm.mapping, u, o).values;
           const double ratio = diffusion::seam_ratio(m, stm.mapping, tex);
           const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
@@ -130,11 +141,40 @@ int main(int argc, char** argv) {
           const std::vector<float> kr = smooth_field(m, SdfDomain::Vertex, u, ko);
           const FieldComparison c = compare_fields(tex, heat);
           const double rms = test::rms_difference(tex, heat), krms = test::rms_difference(kr, heat);
-          std::printf("| %s | %zu | %g | %zu | %.2f | %.2f (%.2f) | %.4f | %.2f %% | %.4f | %.4f (%d) | %.2f | %.2f %% | %.2f |\n", name.c_str(),
+          // The same mapping with one blur width per chart (what the stretch compensation changes).
+          diffusion::DiffuseOptions per_chart = o;
+          per_chart.stretch = false;
+          const double rms1 = test::rms_difference(diffuser.run(m, stm.mapping, u, per_chart).values, heat);
+          std::printf("| %s | %zu | %g | %zu | %.2f | %.2f (%.2f) | %.4f | %.2f %% | %.4f | %.4f (%d) | %.2f | %.2f | %.2f %% | %.2f |\n", name.c_str(),
                       m.vertex_count(), static_cast<double>(edges), stm.mapping.charts.size(),
                       static_cast<double>(stm.mapping.triangles.size()) / static_cast<double>(m.triangles.size()), ratio, heat_ratio,
-                      c.pearson, 100.0 * c.median_relative, rms, krms, ko.rings, krms > 0 ? rms / krms : 0.0, 100.0 * stm.quality.overlap,
-                      stm.quality.seconds);
+                      c.pearson, 100.0 * c.median_relative, rms, krms, ko.rings, krms > 0 ? rms / krms : 0.0,
+                      krms > 0 ? rms1 / krms : 0.0, 100.0 * stm.quality.overlap, stm.quality.seconds);
+          summary[si].texk_per_chart.push_back(krms > 0 ? rms1 / krms : 0.0);
+          if (by_kind) {
+            // Squared errors of texture space and k-ring against heat, summed per kind of the
+            // vertex's own chart.
+            double tex2[3] = {}, k2[3] = {}, all = 0.0;
+            std::size_t count[3] = {};
+            for (std::size_t v = 0; v < tex.size(); ++v) {
+              const auto kind = static_cast<std::size_t>(stm.mapping.charts[stm.mapping.vertex_chart[v]].kind);
+              const double dt = static_cast<double>(tex[v]) - heat[v], dk = static_cast<double>(kr[v]) - heat[v];
+              tex2[kind] += dt * dt;
+              k2[kind] += dk * dk;
+              all += dt * dt;
+              ++count[kind];
+            }
+            std::printf("|   by kind | ");
+            const char* names[3] = {"bone", "joint", "sheet"};
+            for (std::size_t k = 0; k < 3; ++k) {
+              if (count[k] == 0) continue;
+              const double n = static_cast<double>(count[k]);
+              std::printf("%s: %.0f %% of vertices, tex rms %.4f, k-ring rms %.4f, %.0f %% of tex error; ", names[k],
+                          100.0 * n / static_cast<double>(tex.size()), std::sqrt(tex2[k] / n), std::sqrt(k2[k] / n),
+                          all > 0 ? 100.0 * tex2[k] / all : 0.0);
+            }
+            std::printf("|\n");
+          }
           summary[si].seam.push_back(ratio);
           summary[si].texk.push_back(krms > 0 ? rms / krms : 0.0);
           summary[si].pearson.push_back(c.pearson);
@@ -152,13 +192,14 @@ int main(int argc, char** argv) {
       for (double x : v) n += pred(x) ? 1 : 0;
       return n;
     };
-    std::printf("\n| sigma (edges) | meshes | seam ratio median | seam ratio <= 1.5 | tex/k median | tex/k <= 1 | pearson >= 0.95 |\n"
-                "|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("\n| sigma (edges) | meshes | seam ratio median | seam ratio <= 1.5 | tex/k median | tex/k <= 1 | pearson >= 0.95 | "
+                "tex/k per chart median | tex/k per chart <= 1 |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (std::size_t si = 0; si < sigmas.size(); ++si) {
       const Summary& u = summary[si];
-      std::printf("| %g | %zu | %.2f | %zu | %.2f | %zu | %zu |\n", static_cast<double>(sigmas[si]), u.seam.size(), median(u.seam),
+      std::printf("| %g | %zu | %.2f | %zu | %.2f | %zu | %zu | %.2f | %zu |\n", static_cast<double>(sigmas[si]), u.seam.size(), median(u.seam),
                   count(u.seam, [](double x) { return x <= 1.5; }), median(u.texk), count(u.texk, [](double x) { return x <= 1.0; }),
-                  count(u.pearson, [](double x) { return x >= 0.95; }));
+                  count(u.pearson, [](double x) { return x >= 0.95; }), median(u.texk_per_chart),
+                  count(u.texk_per_chart, [](double x) { return x <= 1.0; }));
     }
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

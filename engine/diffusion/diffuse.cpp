@@ -38,9 +38,10 @@ vk::Pipeline make_raster_pipeline(vk::Context& ctx) {
   d.push_bytes = sizeof(passes::RasterPush);
   d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, uv)},
                   {1, 0, VK_FORMAT_R32_SFLOAT, offsetof(passes::RasterVertex, value)},
-                  {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)}};
+                  {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)},
+                  {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, stretch)}};
   d.vertex_stride = sizeof(passes::RasterVertex);
-  d.color_formats = {kRasterFormat};
+  d.color_formats = {kRasterFormat, kRasterFormat};  // (value, coverage), stretch
   d.depth_write = false;
   return vk::create_graphics_pipeline(ctx, d);
 }
@@ -82,6 +83,21 @@ void check_options(const DiffuseOptions& o) {
   if (!std::isfinite(o.radius_px) || !std::isfinite(o.sigma) || o.radius_px < 0.0f || o.sigma < 0.0f)
     throw InputError("the diffusion's radius and sigma must be finite and positive");
   if (r == s) throw InputError("texture-space diffusion needs exactly one of a radius in texels or a sigma in model units");
+  if (r && !o.stretch)
+    throw InputError("turning the stretch compensation off needs a sigma in model units (a radius in texels never stretches)");
+}
+
+// Model units per texel along the atlas's x and y over an atlas triangle: the columns of the
+// Jacobian dX/d(uv) = [x1 - x0, x2 - x0] · [uv1 - uv0, uv2 - uv0]^-1. (0, 0) for a triangle
+// degenerate in the atlas (the blur then takes its chart's mean scale).
+glm::vec2 triangle_stretch(const glm::vec3 (&x)[3], const glm::vec2 (&uv)[3]) {
+  const glm::dvec3 e1 = glm::dvec3(x[1]) - glm::dvec3(x[0]), e2 = glm::dvec3(x[2]) - glm::dvec3(x[0]);
+  const glm::dvec2 d1 = glm::dvec2(uv[1]) - glm::dvec2(uv[0]), d2 = glm::dvec2(uv[2]) - glm::dvec2(uv[0]);
+  const double det = d1.x * d2.y - d1.y * d2.x;
+  if (!(std::abs(det) > 1e-9)) return glm::vec2(0.0f);
+  const glm::dvec3 du = (e1 * d2.y - e2 * d1.y) / det, dv = (e2 * d1.x - e1 * d2.x) / det;
+  const glm::vec2 s(static_cast<float>(glm::length(du)), static_cast<float>(glm::length(dv)));
+  return std::isfinite(s.x) && std::isfinite(s.y) ? s : glm::vec2(0.0f);
 }
 
 }  // namespace
@@ -118,6 +134,7 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, d
   check_options(options);
   BlurPlan plan;
   bool axis_fused[2] = {false, false}, axis_cascade[2] = {false, false};
+  plan.stretch = options.sigma > 0.0f && options.stretch;
   for (const Chart& c : mapping.charts) {
     auto r = box_radii(sigma_px_of(c, options, interp_variance));
     // A periodic box no wider than the period (the shader wraps an index once at most).
@@ -134,13 +151,19 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, d
       // A short line runs whole in private memory (any radius); a longer one streams.
       const bool whole = n <= passes::kShortLine;
       fused[static_cast<std::size_t>(axis)] =
-          options.fused_blur && (whole || (std::max({e[0], e[1], e[2]}) <= passes::kFusedMaxRadius && 2 * overrun <= n));
+          options.fused_blur && !plan.stretch && (whole || (std::max({e[0], e[1], e[2]}) <= passes::kFusedMaxRadius && 2 * overrun <= n));
       if (fused[static_cast<std::size_t>(axis)]) {
         // Every texel read once (a streamed line: what leaves box 0's window comes from a ring); a
         // streamed wrapping row also reads its overrun (a plain line reads nothing outside itself).
         plan.texel_reads += lines * (n + (wrap && !whole ? overrun : 0));
         plan.fused_lines += lines;
         axis_fused[axis] = true;
+      } else if (plan.stretch) {
+        // Per box and texel: the prefix walk's read, then the half-width, two prefix sums and the
+        // two fractional end texels, whatever the widths.
+        plan.texel_reads += lines * 3 * 6 * n;
+        plan.cascade_lines += lines;
+        axis_cascade[axis] = true;
       } else {
         for (int b = 0; b < 3; ++b) plan.texel_reads += lines * (2 * n + 2ull * r[static_cast<std::size_t>(b)] + 1);
         plan.cascade_lines += lines;
@@ -219,11 +242,12 @@ struct Diffuser::Impl {
         raster(make_raster_pipeline(c)),
         blur(make_compute(c, "atlas_blur.comp", 4, sizeof(passes::BlurPush))),
         blur_box(make_compute(c, "atlas_blur_box.comp", 4, sizeof(passes::BlurPush))),
+        blur_stretch(make_compute(c, "atlas_blur_stretch.comp", 6, sizeof(passes::StretchBlurPush))),
         sample(make_compute(c, "atlas_sample.comp", 5, sizeof(passes::SamplePush))),
         dilate(make_compute(c, "atlas_dilate.comp", 3, sizeof(passes::DilatePush))),
         transients(c) {}
   vk::Context& ctx;
-  vk::Pipeline raster, blur, blur_box, sample, dilate;
+  vk::Pipeline raster, blur, blur_box, blur_stretch, sample, dilate;
   vk::TransientPool transients;
 };
 
@@ -250,7 +274,12 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     throw DeviceError("a " + std::to_string(size) + "² atlas is larger than the device allows");
 
   DiffuseResult result;
-  result.plan = plan_blur(mapping, options, options.sigma > 0.0f ? interpolation_variance(mesh) : 0.0);
+  const double interp_variance = options.sigma > 0.0f ? interpolation_variance(mesh) : 0.0;
+  result.plan = plan_blur(mapping, options, interp_variance);
+  // The stretch blur's prefix sums take two texel buffers' bytes (vec4 per texel).
+  if (result.plan.stretch && ctx.capabilities().max_storage_buffer_range &&
+      2 * texel_bytes > ctx.capabilities().max_storage_buffer_range)
+    throw DeviceError("a " + std::to_string(size) + "² atlas is larger than the device allows for the stretch-compensated blur's prefix sums");
 
   // Chart table.
   std::vector<passes::GpuChart> charts;
@@ -258,7 +287,9 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   for (std::size_t c = 0; c < mapping.charts.size(); ++c) {
     const Chart& ch = mapping.charts[c];
     const auto& r = result.plan.radii[c];
-    charts.push_back({glm::uvec4(ch.x0, ch.y0, ch.width, ch.height), glm::uvec4(r[0], r[1], r[2], ch.wraps_x ? 1u : 0u)});
+    const float metric = ch.texels_per_unit > 0.0f ? 1.0f / ch.texels_per_unit : 1.0f;
+    charts.push_back({glm::uvec4(ch.x0, ch.y0, ch.width, ch.height), glm::uvec4(r[0], r[1], r[2], ch.wraps_x ? 1u : 0u),
+                      glm::vec4(metric, 0.0f, 0.0f, 0.0f)});
   }
   vk::Buffer chart_buf = make_buffer(ctx, charts.size() * sizeof(passes::GpuChart), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                      vk::MemoryUse::Upload);
@@ -272,8 +303,10 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     const Chart& ch = mapping.charts[t.chart];
     const auto& face = mesh.triangles[t.face];
     glm::vec2 uv[3] = {t.uv[0], t.uv[1], t.uv[2]};
+    const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
     if (!ch.wraps_x) {
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], values[face[k]], t.chart});
+      const glm::vec2 st = triangle_stretch(x, uv);
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], values[face[k]], t.chart, st});
       continue;
     }
     const float w = static_cast<float>(ch.width);
@@ -281,11 +314,12 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
       while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
       while (uv[0].x - uv[k].x > 0.5f * w) uv[k].x += w;
     }
+    const glm::vec2 st = triangle_stretch(x, uv);
     const float lo = std::min({uv[0].x, uv[1].x, uv[2].x}), hi = std::max({uv[0].x, uv[1].x, uv[2].x});
     for (int s = -2; s <= 2; ++s) {
       const float shift = static_cast<float>(s) * w;
       if (hi + shift <= static_cast<float>(ch.x0) || lo + shift >= static_cast<float>(ch.x0) + w) continue;
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), values[face[k]], t.chart});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), values[face[k]], t.chart, st});
     }
   }
   vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
@@ -355,15 +389,22 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   const auto range_h = graph.import_buffer("atlas.ranges", range_buf.size, host_written(range_buf));
   const auto value_h = graph.import_buffer("atlas.values", value_buf.size, {value_buf.get()});
   const auto target = graph.create_image("atlas.raster", {kRasterFormat, size, size, 1});
+  const auto stretch_target = graph.create_image("atlas.raster.stretch", {kRasterFormat, size, size, 1});
+  const auto stretch = graph.create_buffer("atlas.stretch", VkDeviceSize{size} * size * sizeof(glm::vec2));
   const auto texels = graph.create_buffer("atlas.texels", texel_bytes);
   const auto scratch = graph.create_buffer("atlas.scratch", texel_bytes);
 
   passes::AtlasRasterPass rp;
   rp.pipeline = &impl_->raster;
   rp.target = target;
+  rp.stretch_target = stretch_target;
   rp.vertices = soup_h;
   rp.charts = chart_h;
   rp.texels = texels;
+  rp.stretch = stretch;
+  const float variance =
+      options.sigma > 0.0f ? static_cast<float>(std::max(static_cast<double>(options.sigma) * options.sigma - interp_variance, 0.0)) : 0.0f;
+  rp.variance = variance;
   rp.vertex_count = static_cast<std::uint32_t>(soup.size());
   rp.size = size;
   const auto rastered = passes::add_atlas_raster_pass(graph, rp);
@@ -371,7 +412,13 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   passes::AtlasBlurPass bp;
   bp.pipeline = &impl_->blur;
   bp.box_pipeline = &impl_->blur_box;
-  bp.texels = rastered;
+  if (result.plan.stretch) {
+    bp.stretch_pipeline = &impl_->blur_stretch;
+    bp.stretch = rastered.stretch;
+    bp.prefix = graph.create_buffer("atlas.prefix", 2 * texel_bytes);  // vec4 per texel: (hi, lo)
+    bp.variance = variance;
+  }
+  bp.texels = rastered.texels;
   bp.scratch = scratch;
   bp.charts = chart_h;
   bp.jobs = job_h;
@@ -380,7 +427,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   bp.columns_fused = counts[2];
   bp.columns_cascade = counts[3];
   bp.size = size;
-  const auto blurred = options.blur ? passes::add_atlas_blur_passes(graph, bp) : rastered;
+  const auto blurred = options.blur ? passes::add_atlas_blur_passes(graph, bp) : rastered.texels;
 
   passes::AtlasSamplePass sp;
   sp.pipeline = &impl_->sample;

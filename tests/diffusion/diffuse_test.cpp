@@ -7,6 +7,7 @@
 #include "diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/shapes.hpp"
 #include "sdfkit/diffusion/diffuse.hpp"
 #include "sdfkit/diffusion/diffuse_mesh.hpp"
 #include "sdfkit/diffusion/seams.hpp"
@@ -99,6 +100,22 @@ TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   off.fused_blur = false;
   EXPECT_EQ(plan_blur(two, off).fused_lines, 0u);
   EXPECT_EQ(plan_blur(two, off).dispatches, 6u);
+  // A sigma in model units: stretch-compensated, every line in the three per-box dispatches per
+  // axis, whose reads (six per texel and box: prefix sums) do not grow with sigma either; with
+  // stretch off the radius plan's fused lines.
+  DiffuseOptions s1, s32;
+  s1.sigma = 0.2f;   // 2 texels at 10 texels per unit
+  s32.sigma = 6.4f;  // 64 texels
+  const BlurPlan q1 = plan_blur(a, s1), q32 = plan_blur(a, s32);
+  EXPECT_TRUE(q1.stretch);
+  EXPECT_FALSE(p2.stretch);
+  EXPECT_EQ(q1.fused_lines, 0u);
+  EXPECT_EQ(q1.cascade_lines, 2u * 2044u);
+  EXPECT_EQ(q1.dispatches, 6u);
+  EXPECT_LE(static_cast<double>(q32.texel_reads), 1.1 * static_cast<double>(q1.texel_reads));
+  s1.stretch = false;
+  EXPECT_FALSE(plan_blur(a, s1).stretch);
+  EXPECT_EQ(plan_blur(a, s1).fused_lines, 2u * 2044u);
 }
 
 TEST(DiffusePlan, KRingForSigmaPutsTheLastRingNearTwoSigma) {
@@ -118,6 +135,10 @@ TEST_F(Diffuse, BadOptionsAndMappingsAreInputErrors) {
   both.radius_px = 2.0f;
   both.sigma = 0.1f;
   EXPECT_THROW(diffuser_->run(m, a, u, both), InputError);
+  DiffuseOptions radius_flat;  // a radius in texels has no stretch to turn off
+  radius_flat.radius_px = 2.0f;
+  radius_flat.stretch = false;
+  EXPECT_THROW(diffuser_->run(m, a, u, radius_flat), InputError);
   AtlasMapping bad = a;
   bad.charts[0].width = 600;  // leaves the atlas
   EXPECT_THROW(diffuser_->run(m, bad, u, sigma_of(0.1f)), InputError);
@@ -329,10 +350,12 @@ struct HeatComparison {
   int rings = 0;
 };
 HeatComparison compare_with_heat(Diffuser& diffuser, const Mesh& m, const AtlasMapping& a, const std::vector<float>& u,
-                                 float sigma, float edge) {
+                                 float sigma, float edge, bool stretch = true) {
   const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
   HeatComparison c;
-  c.texture_values = diffuser.run(m, a, u, sigma_of(sigma)).values;
+  DiffuseOptions o = sigma_of(sigma);
+  o.stretch = stretch;
+  c.texture_values = diffuser.run(m, a, u, o).values;
   SmoothOptions so;
   so.sigma = sigma;
   so.rings = c.rings = kring_for_sigma(sigma, edge);
@@ -376,8 +399,9 @@ TEST_F(Diffuse, MatchesHeatDiffusionOnACylinder) {
 // u = x² + y² adds exactly its variance per axis twice, so on a flat grid through one isometric
 // chart the read-back minus u, halved, is the whole road's variance per axis. It equals the box
 // cascade's (radii from the plan) plus interpolation_variance plus 1/6 texel², within 1 %, and the
-// requested sigma² within the rounding of the integer boxes. The grid's texel scale (1.37 texels per
-// edge) spreads the vertices over all fractions of a texel.
+// requested sigma² within the rounding of the integer boxes (one width per chart). The
+// stretch-compensated blur (the default) gives sigma² itself within 1 %. The grid's texel scale
+// (1.37 texels per edge) spreads the vertices over all fractions of a texel.
 TEST_F(Diffuse, TheRoadAroundTheBlurAddsTheDerivedVariance) {
   const int n = 34;
   Mesh m;
@@ -405,28 +429,104 @@ TEST_F(Diffuse, TheRoadAroundTheBlurAddsTheDerivedVariance) {
   std::vector<float> u;
   for (const glm::vec3& p : m.positions) u.push_back((p.x - c) * (p.x - c) + (p.y - c) * (p.y - c));
   for (float sigma : {1.5f, 2.5f}) {
-    const DiffuseResult r = diffuser_->run(m, a, u, sigma_of(sigma));
-    double sum = 0.0;
-    int count = 0;
-    const float margin = 4.0f * sigma + 1.0f;
-    for (std::size_t v = 0; v < u.size(); ++v) {
-      const glm::vec3 p = m.positions[v];
-      if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
-      sum += (static_cast<double>(r.values[v]) - u[v]) / 2.0;
-      ++count;
-    }
-    ASSERT_GT(count, 50);
-    const double measured = sum / count;
+    // The measured variance per axis of the whole road: (read-back - u) / 2 away from the borders.
+    const auto measure = [&](const DiffuseResult& r) {
+      double sum = 0.0;
+      int count = 0;
+      const float margin = 4.0f * sigma + 1.0f;
+      for (std::size_t v = 0; v < u.size(); ++v) {
+        const glm::vec3 p = m.positions[v];
+        if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
+        sum += (static_cast<double>(r.values[v]) - u[v]) / 2.0;
+        ++count;
+      }
+      EXPECT_GT(count, 50);
+      return sum / std::max(count, 1);
+    };
+    // One width per chart: integer boxes from the plan.
+    DiffuseOptions per_chart = sigma_of(sigma);
+    per_chart.stretch = false;
+    const DiffuseResult r = diffuser_->run(m, a, u, per_chart);
+    EXPECT_FALSE(r.plan.stretch);
+    const double measured = measure(r);
     double boxes = 0.0;
     for (std::uint32_t x : r.plan.radii[0]) boxes += ((2.0 * x + 1) * (2.0 * x + 1) - 1.0) / 12.0;
     const double predicted = boxes / (tpu * tpu) + interpolation_variance(m) + 1.0 / (6.0 * tpu * tpu);
     EXPECT_NEAR(measured, predicted, 0.01 * predicted) << "sigma " << sigma;
     const double px = std::sqrt(std::max(sigma * sigma * tpu * tpu - interpolation_variance(m) * tpu * tpu - 1.0 / 6.0, 0.0));
     EXPECT_NEAR(measured, sigma * sigma, std::abs(boxes - px * px) / (tpu * tpu) + 0.01 * sigma * sigma) << "sigma " << sigma;
+    // Stretch-compensated (the default): the boxes' fractional ends give each box exactly a third
+    // of the variance left for the blur (glsl/atlas_blur_stretch.comp), so the road's variance is
+    // the requested sigma² without the integer boxes' rounding.
+    const DiffuseResult rs = diffuser_->run(m, a, u, sigma_of(sigma));
+    EXPECT_TRUE(rs.plan.stretch);
+    const double stretched = measure(rs);
+    EXPECT_NEAR(stretched, sigma * sigma, 0.01 * sigma * sigma) << "sigma " << sigma;
     std::printf("sigma %.1f: variance per axis measured %.4f, derived %.4f (boxes %.4f + interpolation %.4f + read-back %.4f), "
-                "requested %.4f\n", static_cast<double>(sigma), measured, predicted, boxes / (tpu * tpu), interpolation_variance(m),
-                1.0 / (6.0 * tpu * tpu), static_cast<double>(sigma * sigma));
+                "stretch-compensated %.4f, requested %.4f\n", static_cast<double>(sigma), measured, predicted, boxes / (tpu * tpu),
+                interpolation_variance(m), 1.0 / (6.0 * tpu * tpu), stretched, static_cast<double>(sigma * sigma));
   }
+}
+
+// The stretch buffer's two axes: the same flat grid through a chart that scales x and y
+// differently (1.37 and 2.9 texels per unit, the chart's mean 2 between). A Gaussian blur of
+// u = x² adds the variance along x, of u = y² the variance along y; with the stretch
+// compensation both are the requested sigma² within 1 % (each axis's box widths come from its own
+// column of the map's Jacobian; measured 4.0022 and 3.9975 for 4), where one width per chart at
+// the mean scale is off by about the squared ratio of the scales on each axis (measured 8.07 and
+// 1.93).
+TEST_F(Diffuse, StretchCompensationUsesEachAxisOwnScale) {
+  const int n = 34;
+  Mesh m;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) m.positions.push_back({static_cast<float>(i), static_cast<float>(j), 0.0f});
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const auto v = static_cast<std::uint32_t>(j * n + i), w = static_cast<std::uint32_t>(n);
+      m.triangles.push_back({v, v + 1, v + w + 1});
+      m.triangles.push_back({v, v + w + 1, v + w});
+    }
+  const float sx = 1.37f, sy = 2.9f;
+  AtlasMapping a;
+  a.size = 128;
+  a.gutter = 2;
+  a.charts.push_back({Chart::Kind::Joint, 2, 2, static_cast<std::uint32_t>(std::ceil((n - 1) * sx)) + 1,
+                      static_cast<std::uint32_t>(std::ceil((n - 1) * sy)) + 1, false, 2.0f});
+  const auto uv = [&](glm::vec3 p) { return glm::vec2(2.5f + p.x * sx, 2.5f + p.y * sy); };
+  for (std::uint32_t f = 0; f < m.triangles.size(); ++f)
+    a.triangles.push_back({0, f, {uv(m.positions[m.triangles[f][0]]), uv(m.positions[m.triangles[f][1]]), uv(m.positions[m.triangles[f][2]])}});
+  a.vertex_chart.assign(m.positions.size(), 0);
+  for (const glm::vec3& p : m.positions) a.vertex_uv.push_back(uv(p));
+  const float c = (n - 1) / 2.0f, sigma = 2.0f;
+  std::vector<float> ux, uy;
+  for (const glm::vec3& p : m.positions) {
+    ux.push_back((p.x - c) * (p.x - c));
+    uy.push_back((p.y - c) * (p.y - c));
+  }
+  // The road's variance along one axis: read-back - u away from the borders (u = x² or y²).
+  const auto variance = [&](const std::vector<float>& u, bool stretch) {
+    DiffuseOptions o = sigma_of(sigma);
+    o.stretch = stretch;
+    const DiffuseResult r = diffuser_->run(m, a, u, o);
+    double sum = 0.0;
+    int count = 0;
+    const float margin = 4.0f * sigma + 1.0f;
+    for (std::size_t v = 0; v < u.size(); ++v) {
+      const glm::vec3 p = m.positions[v];
+      if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
+      sum += static_cast<double>(r.values[v]) - u[v];
+      ++count;
+    }
+    EXPECT_GT(count, 50);
+    return sum / std::max(count, 1);
+  };
+  const double s2 = sigma * sigma;
+  const double vx = variance(ux, true), vy = variance(uy, true), fx = variance(ux, false), fy = variance(uy, false);
+  EXPECT_NEAR(vx, s2, 0.01 * s2);
+  EXPECT_NEAR(vy, s2, 0.01 * s2);
+  EXPECT_GT(std::abs(fx - s2), 0.1 * s2);
+  EXPECT_GT(std::abs(fy - s2), 0.1 * s2);
+  std::printf("sigma² %.3f: stretch-compensated variance along x %.4f, y %.4f; one width per chart %.4f, %.4f\n", s2, vx, vy, fx, fy);
 }
 
 // smooth_texture_space builds the mapping with the band the blur needs: kBandSigmas sigma with
@@ -483,12 +583,13 @@ namespace {
 // blur needs (StmOptions::overlap) and every vertex read back from every chart covering it,
 // blended (StmOptions::blend). Against heat diffusion at 1..5 mean edges: Pearson >= 0.95, median
 // relative difference <= 5 %, at most 0.9x the RMS of k-ring smoothing at the same sigma (measured
-// 0.75 / 0.71 / 0.66 / 0.60x at 1 / 2 / 3 / 5 edges), and no seams: the P95 jump across chart
-// borders is at most 1.5 times the one inside charts (measured 0.98 / 1.03 / 1.10 / 1.20; the heat
-// field's own ratio over the same borders is 0.97..1.05). At 1 and 3 edges the blend and the band
-// each lower the seam ratio and the RMS: read back from the own chart alone (measured seam ratio
-// 1.42 / 4.76, RMS 0.0071 / 0.0075 against the blend's 0.0061 / 0.0061), and one ring without the
-// band (3.97 / 13.5, RMS 0.0084 / 0.0151).
+// with the stretch-compensated blur 0.56 / 0.60 / 0.61 / 0.54x at 1 / 2 / 3 / 5 edges; one width
+// per chart gave 0.75 / 0.71 / 0.66 / 0.60x), and no seams: the P95 jump across chart borders is
+// at most 1.5 times the one inside charts (measured 1.04 / 1.11 / 1.10 / 1.24; the heat field's
+// own ratio over the same borders is 0.97..1.05). At 1 and 3 edges the blend and the band each
+// lower the seam ratio and the RMS: read back from the own chart alone (measured seam ratio
+// 1.34 / 3.65, RMS 0.0053 / 0.0072 against the blend's 0.0045 / 0.0056), and one ring without
+// the band (3.85 / 11.55, RMS 0.0067 / 0.0138).
 TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
   const Mesh m = io::load_asset(test::data_mesh("camel.off")).mesh;
   const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
@@ -530,6 +631,36 @@ TEST_F(Diffuse, RealMeshThroughTheSkeletonTextureMapping) {
     EXPECT_LT(c0.texture.rms, c1.texture.rms) << edges << " edges";
     std::printf("camel sigma %.0f edges, own chart only: seam ratio %.2f, rms %.4f; without the band: %.2f, %.4f\n",
                 edges, ratio0, c0.texture.rms, ratio1, c1.texture.rms);
+  }
+}
+
+// The stretch-compensated blur (DiffuseOptions::stretch) on a bone whose radius varies tenfold
+// along it: the paper's swept tube (diameter 2 to 20 along a Bezier curve, flat caps) through its
+// extracted skeleton's mapping. A bone chart's angle direction is scaled by the bone's median
+// radius, so one blur width per chart is up to ~3x too wide in model units at the thin end and
+// ~3x too narrow at the thick end; with the width set per texel from the map's local stretch, the
+// texture space is no further from heat diffusion than k-ring smoothing at 2..5 edges (RMS), and
+// nearer than with one width per chart.
+TEST_F(Diffuse, StretchCompensatedBlurFollowsABoneOfVaryingRadius) {
+  const Mesh m = shapes::swept_tube(2.0f, 20.0f, 60, 32).mesh;
+  const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
+  const std::vector<float> u = test::wave_field(m);
+  const float edge = mean_edge_length(m);
+  for (float edges : {2.0f, 3.0f, 5.0f}) {
+    const float sigma = edges * edge;
+    StmOptions so;
+    so.overlap = kBandSigmas * sigma;
+    const AtlasMapping a = build_stm(m, skel, so).mapping;
+    const HeatComparison c = compare_with_heat(*diffuser_, m, a, u, sigma, edge);
+    const HeatComparison flat = compare_with_heat(*diffuser_, m, a, u, sigma, edge, false);
+    EXPECT_GE(c.texture.pearson, 0.95) << edges << " edges";
+    EXPECT_LE(c.texture.median_rel, 0.05) << edges << " edges";
+    EXPECT_LE(c.texture.rms, c.kring.rms) << edges << " edges";
+    EXPECT_LT(c.texture.rms, flat.texture.rms) << edges << " edges";
+    std::printf("tube sigma %.0f edges (%zu charts): stretch rms %.5f pearson %.4f median %.4f | one width per chart rms %.5f | "
+                "k-ring (k=%d) rms %.5f\n",
+                edges, a.charts.size(), c.texture.rms, c.texture.pearson, c.texture.median_rel, flat.texture.rms, c.rings,
+                c.kring.rms);
   }
 }
 

@@ -78,10 +78,16 @@ TEST(PushConstants, FigureStructsMatchTheirGlslBlocks) {
 TEST(PushConstants, AtlasStructsMatchTheirGlslBlocks) {
   using namespace diffusion::passes;
   expect_block("atlas_raster.vert", {{SDFKIT_OFF(RasterPush, scale)}, sizeof(RasterPush)});
+  expect_block("atlas_raster.frag", {{SDFKIT_OFF(RasterPush, scale)}, sizeof(RasterPush)});
   for (const char* blur : {"atlas_blur.comp", "atlas_blur_box.comp"})
     expect_block(blur, {{SDFKIT_OFF(BlurPush, job_offset), SDFKIT_OFF(BlurPush, job_count), SDFKIT_OFF(BlurPush, size),
                          SDFKIT_OFF(BlurPush, axis), SDFKIT_OFF(BlurPush, box), SDFKIT_OFF(BlurPush, src_tiled)},
                         sizeof(BlurPush)});
+  expect_block("atlas_blur_stretch.comp",
+               {{SDFKIT_OFF(StretchBlurPush, job_offset), SDFKIT_OFF(StretchBlurPush, job_count),
+                 SDFKIT_OFF(StretchBlurPush, size), SDFKIT_OFF(StretchBlurPush, axis), SDFKIT_OFF(StretchBlurPush, box),
+                 SDFKIT_OFF(StretchBlurPush, src_tiled), SDFKIT_OFF(StretchBlurPush, variance)},
+                sizeof(StretchBlurPush)});
   expect_block("atlas_sample.comp",
                {{SDFKIT_OFF(SamplePush, vertex_count), SDFKIT_OFF(SamplePush, size)}, sizeof(SamplePush)});
   expect_block("atlas_dilate.comp",

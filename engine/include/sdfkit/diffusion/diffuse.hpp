@@ -5,13 +5,17 @@
 //
 //   atlas_raster  the AtlasTriangles, per-corner values, into an RG32F atlas (value, coverage 1),
 //                 each fragment clipped to its chart's rectangle (a triangle across the seam of a
-//                 wrapping chart is drawn once per side); copied into a texel buffer
+//                 wrapping chart is drawn once per side); copied into a texel buffer. Beside it
+//                 each triangle's stretch (model units per texel along x and y, the columns of
+//                 its map's Jacobian) into a second RG32F target, copied into a stretch buffer
 //   atlas_blur    a separable Gaussian as a cascade of three box filters per axis (one compute
 //                 pass per axis), each box a running sum along a row or column of one chart: the work per
 //                 texel is the same at every radius. Rows of a wrapping chart wrap; outside its
 //                 rectangle a chart sees zeros, and both channels are blurred, so the value read
 //                 back is blur(value·coverage) / blur(coverage) (normalized convolution): nothing
-//                 from another chart, from the gutter or from uncovered texels ever comes in
+//                 from another chart, from the gutter or from uncovered texels ever comes in.
+//                 With a sigma, each box's width is per texel (the stretch buffer), each box from
+//                 the line's prefix sums (three compute passes per axis)
 //   atlas_sample  per vertex, bilinear at vertex_uv inside the vertex's chart, normalized; with
 //                 AtlasMapping::samples, the weighted blend of such reads in every chart covering
 //                 the vertex (build_stm's partition of unity across chart borders)
@@ -19,9 +23,12 @@
 //                 and half the gutter around each chart filled from the nearest covered texel of the
 //                 same chart, for a texture consumer (TEXCOORD_1) and the PNG
 //
-// Scale: with `sigma` (model units) each chart blurs with sigma · texels_per_unit texels, so the
-// blur is a Gaussian of sigma on the surface wherever the mapping is isometric; with `radius_px`
-// every chart blurs with that many texels (the paper's Table 2). A Gaussian of sigma on the
+// Scale: with `sigma` (model units) every texel blurs with sigma over its own model units per
+// texel along each axis (the stretch buffer; DiffuseOptions::stretch, glsl/atlas_blur_stretch.comp),
+// so the blur is sigma in model units along both atlas axes wherever the map stretches (a bone
+// chart's angle direction scales with the radius around the bone; the map's shear is not
+// compensated), not only where it is isometric at the chart's mean scale (stretch off: sigma · texels_per_unit per
+// chart); with `radius_px` every chart blurs with that many texels (the paper's Table 2). A Gaussian of sigma on the
 // surface is heat flow for time t = sigma² / 2 (tests/diffusion hold it to that).
 
 #include "sdfkit/core/mesh.hpp"
@@ -42,7 +49,7 @@ namespace sdfkit::diffusion {
 
 struct DiffuseOptions {
   float radius_px = 0.0f;  // the Gaussian's standard deviation in atlas texels, every chart; or
-  float sigma = 0.0f;      // in model units, per chart sigma · texels_per_unit. Exactly one > 0.
+  float sigma = 0.0f;      // in model units (per texel from the map's stretch, see `stretch`). Exactly one > 0.
   bool keep_atlas = false; // also return the dilated, normalized atlas (DiffuseResult::atlas)
   bool profile = false;    // per-pass device times (DiffuseResult::timings)
   // false: the graph without the blur passes (raster, sample): the benchmark's baseline, so the
@@ -53,6 +60,16 @@ struct DiffuseOptions {
   // where it pays, BlurPlan::fused): the same values to float rounding, for comparison (the
   // benchmark's cascade columns, tests/diffusion).
   bool fused_blur = true;
+  // With sigma (model units): the blur's width is set per texel from the local stretch of the
+  // chart's map (each triangle's model units per texel along the atlas's x and y, rasterized
+  // beside the values), so that it is sigma in model units wherever a chart stretches the
+  // surface (glsl/atlas_blur_stretch.comp, every line in the cascade). false: one width in texels
+  // per chart, sigma · texels_per_unit (the chart's mean scale), through the fused shader where
+  // it pays (BlurPlan::fused), for comparison (sdfkit-seam-bench --no-stretch). With radius_px
+  // the width is one radius in texels everywhere by definition, so a radius blur never stretches
+  // (BlurPlan::stretch false) and this flag must stay at its default: a radius with stretch off is
+  // an InputError.
+  bool stretch = true;
 };
 
 // Where the time went (milliseconds). Device times only with DiffuseOptions::profile.
@@ -80,10 +97,15 @@ struct BlurPlan {
   // row 2 (r0 + r1 + r2)) is at most half the line, since a streamed step costs about two cascade
   // steps. Never with DiffuseOptions::fused_blur off.
   std::vector<std::array<bool, 2>> fused;
+  // Stretch-compensated (DiffuseOptions::stretch with sigma): every line in the cascade, each
+  // box's width per texel from the map's local stretch; radii are then the chart-scale widths,
+  // for reference only.
+  bool stretch = false;
   std::uint64_t fused_lines = 0, cascade_lines = 0;
   std::uint32_t dispatches = 0;    // compute dispatches of the blur: per axis 1 fused + 3 cascade, when used
   std::uint64_t line_jobs = 0;     // rows + columns
-  std::uint64_t texel_reads = 0;   // texels read from storage: fused once per walk, cascade twice per box + warm-up
+  std::uint64_t texel_reads = 0;   // texels read from storage: fused once per walk, cascade twice per box + warm-up,
+                                   // stretch-compensated six per box (prefix walk, half-width, two sums, two ends)
 };
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, double interpolation_variance = 0.0);
 
