@@ -165,10 +165,11 @@ private:
 // Fresh pages of a large buffer, before their first touch, faulted in by all threads at once
 // (MADV_POPULATE_WRITE, one kernel call per 2 MiB instead of a fault per 4 KiB page on first
 // touch, in whatever order the first pass touches them); contents unchanged. Where the kernel
-// refuses (before Linux 5.14), the pages come as usual on first touch. (Huge pages,
-// MADV_HUGEPAGE, were tried as well: on the 2-core VM their zeroing made the weld slower as
-// often as faster.)
+// refuses (before Linux 5.14) or the headers lack it, the pages come as usual on first touch.
+// (Huge pages, MADV_HUGEPAGE, were tried too: no gain measured on the 2-core VM, and one
+// profile spent 46 % of its samples zeroing them; bench/RESULTS.md, s15load.)
 void populate(void* data, std::size_t bytes) {
+#ifdef MADV_POPULATE_WRITE
   constexpr std::size_t kChunk = std::size_t{2} << 20;
   const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
   const auto at = reinterpret_cast<std::uintptr_t>(data);
@@ -178,6 +179,9 @@ void populate(void* data, std::size_t bytes) {
     const std::uintptr_t lo = begin + b * kChunk, hi = std::min<std::uintptr_t>(end, begin + e * kChunk);
     madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_POPULATE_WRITE);
   }, 4);
+#else
+  (void)data, (void)bytes;
+#endif
 }
 
 // A copy of `from` into fresh memory populated on all threads.
