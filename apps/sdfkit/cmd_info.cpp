@@ -18,12 +18,34 @@ void add_info_command(CLI::App& app) {
   cmd->add_option("--weld-tolerance", *tolerance, "Weld positions closer than this (model units; default 1e-6 of the bounding box, 0 = bitwise-equal only)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", *json, "Print JSON instead of text");
+  auto load_only = std::make_shared<bool>(false);
+  cmd->add_flag("--load-only", *load_only,
+                "Only load and weld: print the counts and the load's stage times (read, weld; ms), no topology");
   auto limits = std::make_shared<io::LoadOptions>();
   add_asset_options(*cmd, *limits);
   cmd->callback([=] {
     io::LoadOptions load = *limits;
     load.weld_tolerance = *tolerance;
     const io::Asset asset = load_input(*path, load);
+    if (*load_only) {
+      nlohmann::json times = nlohmann::json::object();
+      for (const StageTiming& s : asset.load_stages) times[s.stage] = s.milliseconds;
+      const nlohmann::json j = {{"file", asset.path},
+                                {"vertices", asset.input_positions.size()},
+                                {"faces", asset.input_triangles.size()},
+                                {"welded_vertices", asset.mesh.positions.size()},
+                                {"time_ms", times}};
+      if (*json) {
+        std::printf("%s\n", j.dump(2).c_str());
+        return;
+      }
+      std::printf("file:               %s\n", asset.path.c_str());
+      std::printf("vertices:           %zu\n", asset.input_positions.size());
+      std::printf("faces:              %zu\n", asset.input_triangles.size());
+      std::printf("welded vertices:    %zu\n", asset.mesh.positions.size());
+      for (const StageTiming& s : asset.load_stages) std::printf("%-20s%.1f ms\n", (s.stage + ":").c_str(), s.milliseconds);
+      return;
+    }
     const MeshReport r = analyze(asset.mesh);
     if (*json) {
       nlohmann::json j = {

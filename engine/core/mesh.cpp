@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -136,20 +137,37 @@ std::vector<glm::vec3> face_centroids(const Mesh& mesh) {
   return out;
 }
 
+namespace {
+// The first index in [0, n) where bad(i) holds, or n; on all threads.
+template <class Bad>
+std::size_t first_bad(std::size_t n, Bad&& bad) {
+  std::atomic<std::size_t> first{n};
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i)
+      if (bad(i)) {
+        std::size_t seen = first.load();
+        while (i < seen && !first.compare_exchange_weak(seen, i)) {}
+        return;
+      }
+  }, 1 << 16);
+  return first.load();
+}
+}  // namespace
+
 void validate_mesh(const Mesh& mesh, const std::string& what) {
   if (mesh.triangles.empty()) throw InputError(what + ": the mesh has no triangles");
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-    const glm::vec3& p = mesh.positions[v];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      throw InputError(what + ": vertex " + std::to_string(v) +
-                       " has a non-finite coordinate (NaN or Inf)");
-  }
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    if (!in_range(mesh, mesh.triangles[f]))
-      throw InputError(what + ": triangle " + std::to_string(f) +
-                       " uses a vertex index out of range (" +
-                       std::to_string(mesh.positions.size()) + " vertices)");
-  }
+  const std::size_t v = first_bad(mesh.positions.size(), [&](std::size_t i) {
+    const glm::vec3& p = mesh.positions[i];
+    return !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z);
+  });
+  if (v < mesh.positions.size())
+    throw InputError(what + ": vertex " + std::to_string(v) +
+                     " has a non-finite coordinate (NaN or Inf)");
+  const std::size_t f = first_bad(mesh.triangles.size(), [&](std::size_t i) { return !in_range(mesh, mesh.triangles[i]); });
+  if (f < mesh.triangles.size())
+    throw InputError(what + ": triangle " + std::to_string(f) +
+                     " uses a vertex index out of range (" +
+                     std::to_string(mesh.positions.size()) + " vertices)");
 }
 
 Mesh transformed(const Mesh& mesh, const float (&m)[16]) {

@@ -60,7 +60,14 @@ SdfField finish_field(const Mesh& mesh, SdfDomain domain, RawSdf raw) {
   }
   if (field.filled_count == 0) return field;
 
-  const Adjacency adj = domain == SdfDomain::Vertex ? vertex_adjacency(mesh) : face_adjacency(mesh);
+  // The rings of the gaps only (the rounds below read no other ring).
+  std::vector<std::uint8_t> gaps;
+  if (domain == SdfDomain::Vertex) {
+    gaps.resize(n);
+    for (std::size_t i = 0; i < n; ++i) gaps[i] = !has[i];
+  }
+  const Adjacency adj = domain == SdfDomain::Vertex ? vertex_adjacency(mesh, gaps) : face_adjacency(mesh);
+  gaps = std::vector<std::uint8_t>();
   // Ring by ring: each round fills every gap that touches a valued point, from values known at
   // the start of the round, so the result does not depend on the order of the points.
   std::vector<std::uint32_t> frontier;

@@ -48,23 +48,24 @@ Adjacency from_pairs(std::size_t n, std::vector<std::pair<std::uint32_t, std::ui
 
 }  // namespace
 
-Adjacency vertex_adjacency(const Mesh& mesh) {
+Adjacency vertex_adjacency(const Mesh& mesh, std::span<const std::uint8_t> rings_of) {
   // Counting build: every corner contributes its two edge neighbours (with duplicates), then
   // each vertex's short list is sorted and de-duplicated in place and the CSR is compacted.
   // O(F) apart from the per-vertex sorts of about a dozen entries.
   const std::size_t n = mesh.positions.size();
+  const auto wanted = [&](std::uint32_t v) { return v < n && (rings_of.empty() || (v < rings_of.size() && rings_of[v])); };
   Adjacency adj;
   adj.offsets.assign(n + 1, 0);
   for (const Triangle& t : mesh.triangles)
     for (int k = 0; k < 3; ++k)
-      if (t[k] < n) adj.offsets[t[k] + 1] += 2;
+      if (wanted(t[k])) adj.offsets[t[k] + 1] += 2;
   std::partial_sum(adj.offsets.begin(), adj.offsets.end(), adj.offsets.begin());
   std::vector<std::uint32_t> fill(adj.offsets.begin(), adj.offsets.end() - 1);
   adj.indices.resize(adj.offsets[n]);
   for (const Triangle& t : mesh.triangles)
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t a = t[k];
-      if (a >= n) continue;
+      if (!wanted(a)) continue;
       adj.indices[fill[a]++] = t[(k + 1) % 3];
       adj.indices[fill[a]++] = t[(k + 2) % 3];
     }

@@ -4,9 +4,13 @@
 
 #include <glm/geometric.hpp>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cstdlib>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -35,10 +39,13 @@ std::uint64_t mix(std::uint64_t h) {
   return h ^ (h >> 33);
 }
 
+// Mixed one coordinate at a time: the xor of the three coordinates' products with odd
+// constants, mixed once, gave distinct cells the same 64 bits (2 pairs among the 6.7M cells of
+// the subdivided armadillo), which sent every weld of that mesh down the general path.
 std::uint64_t cell_hash(std::int64_t x, std::int64_t y, std::int64_t z) {
-  return mix(static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ull ^
-             static_cast<std::uint64_t>(y) * 0xBF58476D1CE4E5B9ull ^
-             static_cast<std::uint64_t>(z) * 0x94D049BB133111EBull);
+  std::uint64_t h = mix(static_cast<std::uint64_t>(x) + 0x9E3779B97F4A7C15ull);
+  h = mix(h ^ static_cast<std::uint64_t>(y));
+  return mix(h ^ static_cast<std::uint64_t>(z));
 }
 
 // Grid cell coordinate, clamped so that +-1 never overflows (a clamped cell holds many points,
@@ -155,6 +162,113 @@ private:
   std::size_t mask_ = 0;
 };
 
+// Fresh pages of a large buffer, before their first touch, faulted in by all threads at once
+// (MADV_POPULATE_WRITE, one kernel call per 2 MiB instead of a fault per 4 KiB page on first
+// touch, in whatever order the first pass touches them); contents unchanged. Where the kernel
+// refuses (before Linux 5.14) or the headers lack it, the pages come as usual on first touch.
+// (Huge pages, MADV_HUGEPAGE, were tried too: no gain measured on the 2-core VM, and one
+// profile spent 46 % of its samples zeroing them; bench/RESULTS.md, s15load.)
+void populate(void* data, std::size_t bytes) {
+#ifdef MADV_POPULATE_WRITE
+  constexpr std::size_t kChunk = std::size_t{2} << 20;
+  const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  const auto at = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t begin = (at + page - 1) / page * page, end = (at + bytes) / page * page;
+  if (end < begin + 2 * kChunk) return;
+  parallel_for((end - begin + kChunk - 1) / kChunk, [&](std::size_t b, std::size_t e) {
+    const std::uintptr_t lo = begin + b * kChunk, hi = std::min<std::uintptr_t>(end, begin + e * kChunk);
+    madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_POPULATE_WRITE);
+  }, 4);
+#else
+  (void)data, (void)bytes;
+#endif
+}
+
+// A copy of `from` into fresh memory populated on all threads.
+template <class T>
+std::vector<T> copy_of(std::span<const T> from) {
+  std::vector<T> to;
+  to.reserve(from.size());
+  populate(to.data(), from.size_bytes());
+  to.assign(from.begin(), from.end());
+  return to;
+}
+
+// Weld's result where nothing merges: the input, and the identity map.
+WeldResult identity_weld(std::span<const glm::vec3> positions, std::span<const Triangle> triangles) {
+  WeldResult r;
+  r.mesh.positions = copy_of(positions);
+  r.mesh.triangles = copy_of(triangles);
+  r.input_to_welded.reserve(positions.size());
+  populate(r.input_to_welded.data(), positions.size() * sizeof(std::uint32_t));
+  r.input_to_welded.resize(positions.size());
+  parallel_for(positions.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) r.input_to_welded[i] = static_cast<std::uint32_t>(i);
+  }, std::size_t{1} << 15);
+  return r;
+}
+
+// Proves in one parallel pass, where it holds, that no vertex has an earlier one within the
+// tolerance (the usual case for an indexed file). Each vertex enters a 32-bit tag of every
+// cell that its +-tolerance box overlaps (for_each_cell: weld's any_cell; its own bucket when
+// exact) into an open-addressing table. weld compares vertex i only with vertices whose own
+// cell lies in i's box; each of them entered its own cell, and i entered every cell of its
+// box, so a pair weld could merge enters some cell twice. Hence, when no tag is entered twice,
+// weld merges nothing. A tag entered twice (a real repeat, or two cells sharing a tag within
+// one probe run) only answers false, and weld takes its general path; so does a table that
+// fills past 7/8 (boxes over many cells), and the pass stops early then.
+template <class ForEachCell>
+bool nothing_merges(std::size_t n, std::span<const glm::vec3> positions, ForEachCell&& for_each_cell) {
+  if (n < 2) return true;
+  const std::size_t size = std::bit_ceil(std::max<std::size_t>(2 * n, 64));
+  const std::size_t mask = size - 1;
+  const std::size_t limit = size / 8 * 7;
+  // calloc: fresh zeroed pages, 0 = an empty slot.
+  const std::unique_ptr<std::uint32_t[], decltype(&std::free)> slots(
+      static_cast<std::uint32_t*>(std::calloc(size, sizeof(std::uint32_t))), &std::free);
+  if (!slots) throw std::bad_alloc();
+  populate(slots.get(), size * sizeof(std::uint32_t));
+  std::atomic<bool> repeated{false};
+  std::atomic<std::size_t> entered{0};
+  parallel_for(n, [&](std::size_t b, std::size_t e) {
+    // A FIFO of cell hashes: each slot is prefetched when its hash is queued and entered
+    // kRing hashes later, so that the table's cache misses overlap.
+    constexpr std::size_t kRing = 32;
+    std::uint64_t ring[kRing];
+    std::size_t head = 0, tail = 0, local = 0, base = 0;  // entries: this thread's since the
+                                                         // last count, everyone's then
+    const auto enter = [&](std::uint64_t hash) {
+      const std::uint32_t tag = static_cast<std::uint32_t>(hash >> 32) | 1u;  // never 0
+      for (std::size_t k = hash & mask;; k = (k + 1) & mask) {
+        std::atomic_ref<std::uint32_t> slot(slots[k]);
+        std::uint32_t seen = slot.load(std::memory_order_relaxed);
+        if (seen == 0 && slot.compare_exchange_strong(seen, tag, std::memory_order_relaxed)) return true;
+        if (seen == tag) return false;
+      }
+    };
+    bool stop = false;
+    for (std::size_t i = b; i < e && !stop; ++i) {
+      if ((i - b) % 512 == 511) {
+        base = entered.fetch_add(local, std::memory_order_relaxed) + local;
+        local = 0;
+        if (repeated.load(std::memory_order_relaxed)) return;
+      }
+      for_each_cell(positions[i], [&](std::uint64_t hash) {
+        __builtin_prefetch(&slots[hash & mask], 1);
+        if (tail - head == kRing && !enter(ring[head++ % kRing])) stop = true;
+        ring[tail++ % kRing] = hash;
+        // Other threads add at most 512 x 8 entries each beyond `base`, which the 1/8 of the
+        // table above the limit holds (a second thread runs from 2^15 vertices up).
+        if (base + ++local > limit) stop = true;
+        return stop;
+      });
+    }
+    while (!stop && head < tail) stop = !enter(ring[head++ % kRing]);
+    if (stop) repeated = true;
+  }, std::size_t{1} << 15);
+  return !repeated;
+}
+
 }  // namespace
 
 float default_weld_tolerance(std::span<const glm::vec3> positions) {
@@ -207,6 +321,7 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
 
   constexpr std::size_t kGrain = 1 << 15;
   constexpr std::size_t kAhead = 16;  // prefetch distance, vertices
+  if (nothing_merges(n, positions, any_cell)) return identity_weld(positions, triangles);
   std::vector<std::uint64_t> hashes(n);  // of each vertex's own cell (exact: of its bits)
   parallel_for(n, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) hashes[i] = hash_of(positions[i]);
@@ -271,19 +386,11 @@ WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> 
   }
   hashes = std::vector<std::uint64_t>();
 
+  // Nothing merges after all (cells of several vertices, none close enough): every vertex is
+  // its own and keeps its number, which is what the numbering below gives, without its serial
+  // pass and the triangles' gather through the map.
+  if (pending == 0) return identity_weld(positions, triangles);
   WeldResult r;
-  if (pending == 0) {
-    // Nothing merges (the usual case for an indexed file): every vertex is its own and keeps
-    // its number, which is what the general path below gives, without its serial numbering
-    // pass and the triangles' gather through the map.
-    r.mesh.positions.assign(positions.begin(), positions.end());
-    r.mesh.triangles.assign(triangles.begin(), triangles.end());
-    r.input_to_welded.resize(n);
-    parallel_for(n, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) r.input_to_welded[i] = static_cast<std::uint32_t>(i);
-    }, kGrain);
-    return r;
-  }
   // Number the welded vertices in input order; map every input vertex.
   r.input_to_welded.resize(n);
   std::uint32_t count = 0;

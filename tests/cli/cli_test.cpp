@@ -64,6 +64,22 @@ TEST_F(Cli, InfoOnARealMesh) {
   EXPECT_NE(r.out.find("components:         1"), std::string::npos) << r.out;
 }
 
+TEST_F(Cli, InfoLoadOnlyGivesTheCountsAndTheLoadStages) {
+  // --load-only skips the topology (no "components") and reports the read and weld times (the
+  // cow has one duplicate vertex).
+  const RunResult r = run("info --load-only --json " + sdfkit::test::data_mesh("cow.off"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"vertices\": 2904"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"welded_vertices\": 2903"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"read\": "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"weld\": "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("components"), std::string::npos) << r.out;
+  const RunResult text = run("info --load-only " + sdfkit::test::data_mesh("cow.off"));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("weld:"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("components"), std::string::npos) << text.out;
+}
+
 TEST_F(Cli, InfoReportsAnOpenMesh) {
   const RunResult r = run("info " + sdfkit::test::data_mesh("cube-ouvert.off") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;

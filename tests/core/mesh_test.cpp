@@ -123,6 +123,26 @@ TEST(Topology, AdjacencyOfATetrahedron) {
   }
 }
 
+TEST(Topology, RingsOfFlaggedVerticesOnlyEqualTheWholeAdjacencys) {
+  const Mesh m = shapes::icosphere(1, 3);
+  const Adjacency all = vertex_adjacency(m);
+  std::vector<std::uint8_t> flags(m.positions.size());
+  for (std::size_t v = 0; v < flags.size(); ++v) flags[v] = v % 3 == 1;
+  const Adjacency some = vertex_adjacency(m, flags);
+  ASSERT_EQ(some.size(), all.size());
+  for (std::size_t v = 0; v < flags.size(); ++v) {
+    const std::vector<std::uint32_t> a(all.indices.begin() + all.offsets[v], all.indices.begin() + all.offsets[v + 1]);
+    const std::vector<std::uint32_t> b(some.indices.begin() + some.offsets[v], some.indices.begin() + some.offsets[v + 1]);
+    if (flags[v]) {
+      EXPECT_EQ(b, a) << v;
+      EXPECT_GE(b.size(), 5u) << v;
+    } else {
+      EXPECT_TRUE(b.empty()) << v;
+    }
+  }
+  EXPECT_LT(some.indices.size(), all.indices.size() / 2);
+}
+
 TEST(Subdivide, QuadruplesFacesKeepsTheSurfaceAndStaysClosed) {
   const Mesh m = shapes::icosphere(1, 2);
   const Mesh s = subdivide_midpoint(m);

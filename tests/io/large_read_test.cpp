@@ -86,6 +86,47 @@ TEST(LargeRead, BinaryPlyRoundTripsPositionsAndValues) {
   ASSERT_EQ(back.values, field.values);
 }
 
+// Binary face rows "3 a b c" are decoded on all threads, 13 bytes apart; a row that is not
+// (a quad late in the file, an index out of range) sends the element to the sequential reader,
+// with the same result and error as before.
+TEST(LargeRead, BinaryPlyFaceRowsInParallelAndTheirFallback) {
+  constexpr std::uint32_t kVertices = 1000, kFaces = 150000, kOdd = 140000;
+  const auto ply = [&](std::uint32_t odd_corners, std::uint32_t odd_index) {
+    std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(kVertices) +
+                    "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                    std::to_string(kFaces) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (std::uint32_t v = 0; v < kVertices; ++v) {
+      const float p[3] = {static_cast<float>(v), static_cast<float>(v % 7), static_cast<float>(v % 13)};
+      s.append(reinterpret_cast<const char*>(p), sizeof p);
+    }
+    for (std::uint32_t f = 0; f < kFaces; ++f) {
+      const std::uint32_t n = f == kOdd ? odd_corners : 3;
+      s += static_cast<char>(n);
+      for (std::uint32_t k = 0; k < n; ++k) {
+        const std::uint32_t v = f == kOdd && k == 1 ? odd_index : (f + k * 17) % kVertices;
+        s.append(reinterpret_cast<const char*>(&v), sizeof v);
+      }
+    }
+    return s;
+  };
+  const auto expected = [&](std::uint32_t f, std::uint32_t k) { return (f + k * 17) % kVertices; };
+  ScratchDir dir;
+  const io::Asset plain = io::load_asset(dir.write("plain.ply", ply(3, expected(kOdd, 1))), {.weld_tolerance = 0.0f});
+  ASSERT_EQ(plain.input_triangles.size(), kFaces);
+  for (std::uint32_t f = 0; f < kFaces; ++f)
+    for (std::uint32_t k = 0; k < 3; ++k) ASSERT_EQ(plain.input_triangles[f][k], expected(f, k)) << f;
+
+  const io::Asset quad = io::load_asset(dir.write("quad.ply", ply(4, expected(kOdd, 1))), {.weld_tolerance = 0.0f});
+  ASSERT_EQ(quad.input_triangles.size(), kFaces + 1);  // the quad as a fan of two
+  EXPECT_EQ(quad.input_triangles[kOdd - 1], plain.input_triangles[kOdd - 1]);
+  EXPECT_EQ(quad.input_triangles[kOdd + 1], (Triangle{expected(kOdd, 0), expected(kOdd, 2), expected(kOdd, 3)}));
+  EXPECT_EQ(quad.input_triangles[kOdd + 2], plain.input_triangles[kOdd + 1]);
+
+  const std::string bad = dir.write("bad.ply", ply(3, kVertices));
+  test::expect_input_error([&] { io::load_asset(bad); }, bad,
+                           "face " + std::to_string(kOdd) + " uses vertex " + std::to_string(kVertices));
+}
+
 // A mesh that cannot fit is refused from the counts, before its arrays are allocated: the
 // limit here is SDFKIT_MEMORY_LIMIT (as on a machine with 1 MB free).
 TEST(LargeRead, AMeshTooLargeForMemoryIsRefusedFromItsCounts) {

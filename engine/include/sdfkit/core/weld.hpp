@@ -30,13 +30,15 @@ float default_weld_tolerance(std::span<const glm::vec3> positions);
 // degenerate, not removed. Indices out of range are copied as they are.
 //
 // Found by hashing a grid of cells 16 x the tolerance (a match lies in the cells that the box of
-// +-tolerance around a point overlaps: 1 to 8 of them, ~1.2 on average): an open-addressing
-// table is filled and looked up in parallel over the hardware threads, and only vertices that
-// have an earlier neighbour within the tolerance are then resolved in input order, through
-// bucket chains kept in index order (many copies of one point cost linear time). When nothing
-// merges, the result is the input's copy with the identity map. Memory beside the result: 16 to
-// 32 bytes per input vertex for the table, 12 for hashes and representatives, 8 to 16 more for
-// the chains when something merges.
+// +-tolerance around a point overlaps: 1 to 8 of them, ~1.4 on average). First, one parallel
+// pass enters every vertex in each cell of its box (a table of 32-bit cell tags): when no cell
+// is entered twice, no vertex has a candidate, nothing merges, and the result is the input's
+// copy with the identity map (8 to 16 bytes per input vertex beside the result). Otherwise an
+// open-addressing table of each vertex's own cell is filled and looked up in parallel over the
+// hardware threads, and only vertices that have an earlier neighbour within the tolerance are
+// then resolved in input order, through bucket chains kept in index order (many copies of one
+// point cost linear time); memory beside the result: 16 to 32 bytes per input vertex for that
+// table, 12 for hashes and representatives, 8 to 16 more for the chains.
 WeldResult weld(std::span<const glm::vec3> positions, std::span<const Triangle> triangles,
                 float tolerance = 0.0f);
 
