@@ -215,15 +215,20 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
 
 #ifdef SDFKIT_BVH
 // Bundles: one work item traces ray r of BUNDLE consecutive points (the host sorts the points
-// in Morton order, so these are neighbours on the surface) as float16 lanes, so a CPU device
+// in Morton order, so these are neighbours on the surface) as float8 lanes, so a CPU device
 // runs each box and triangle test for all of them in one SIMD instruction stream: nearly
 // parallel rays from nearby origins, every lane busy whatever the ray count. Lanes past the
 // last point or of points that cast no rays are inactive (best distance -1: nothing can be
 // entered or hit). A node is entered when any active ray enters it; pending nodes keep the
 // smallest entry distance of their rays and are dropped once every ray has a closer hit.
-#define BUNDLE SDFKIT_BUNDLE_WIDTH  // float16 lanes: the code below is written for 16
-#if BUNDLE != 16
-#error "trace_bundles is written for bundles of 16 (float16)"
+// Eight lanes, not sixteen: the far-side hits of sixteen neighbours' rays spread over many
+// leaves (on armadillo subdivided to 3.3M and 13.3M triangles, a visited leaf was entered by
+// 1.7-1.8 of 16 lanes), so half-width bundles visit far fewer nodes per ray, and a float8
+// operation costs half a float16 one on the 2-core EPYC (Zen 4 runs 512-bit operations as two
+// 256-bit halves). Measured in bench/RESULTS.md.
+#define BUNDLE SDFKIT_BUNDLE_WIDTH  // from the host (opencl_backend.cpp's kBundle)
+#if BUNDLE != 8
+#error "trace_bundles is written for bundles of 8 (float8)"
 #endif
 // The bundle's triangle test rounds like the scalar one and the C++ definition's tests: no
 // contraction (with fma, rays through a shared edge of an axis-aligned face slipped between
@@ -231,42 +236,57 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
 #pragma OPENCL FP_CONTRACT OFF
 
 // (min over a's lanes, min over b's lanes), folded pairwise. Also the "does any lane enter"
-// test (a minimum below INFINITY): any() over a float16 comparison compiled to a lane-by-lane
+// test (a minimum below INFINITY): any() over a vector comparison compiled to a lane-by-lane
 // chain on PoCL 3.1 / LLVM 15 and made the traversal 30 % slower.
-inline float2 pair_min(float16 a, float16 b) {
-  const float16 m16 = min((float16)(a.lo, b.lo), (float16)(a.hi, b.hi));
-  const float8 m8 = min(m16.s012389ab, m16.s4567cdef);
+inline float2 pair_min(float8 a, float8 b) {
+  const float8 m8 = min((float8)(a.lo, b.lo), (float8)(a.hi, b.hi));
   const float4 m4 = min(m8.s0145, m8.s2367);
   return (float2)(min(m4.x, m4.y), min(m4.z, m4.w));
 }
 
-inline float lane_max(float16 t) {
-  const float8 m8 = max(t.lo, t.hi);
-  const float4 m4 = max(m8.lo, m8.hi);
+inline float lane_max(float8 t) {
+  const float4 m4 = max(t.lo, t.hi);
   return max(max(m4.x, m4.y), max(m4.z, m4.w));
 }
 
+// A hint to the cache (clang's __builtin_prefetch, a prefetch instruction on CPUs; the host
+// defines SDFKIT_PREFETCH for CPU devices only) for what visiting the node (word, count) reads
+// first: an internal node's second child's box (its first child's is next to it), a leaf's
+// first triangle records. Loads of far nodes and of triangles took a third of the samples of a
+// profile (perf) of the traversal at 3.3M triangles.
+inline void sdfkit_prefetch_child(__global const float4* bvh, __global const float4* tris,
+                                  uint word, uint count) {
+#if defined(__clang__) && defined(SDFKIT_PREFETCH)
+  if (count & LEAF_BIT) {
+    __builtin_prefetch(tris + 3 * word);
+    __builtin_prefetch(tris + 3 * word + 4);
+  } else {
+    __builtin_prefetch(bvh + 2 * word);
+  }
+#endif
+}
+
 // Per ray of a bundle (origins per lane), the entry distance into a box or INFINITY.
-inline float16 bundle_entry(float4 lo, float4 hi, float16 ox, float16 oy, float16 oz,
-                            float16 ix, float16 iy, float16 iz, float16 best_t) {
-  const float16 ax = (lo.x - ox) * ix, bx = (hi.x - ox) * ix;
-  const float16 ay = (lo.y - oy) * iy, by = (hi.y - oy) * iy;
-  const float16 az = (lo.z - oz) * iz, bz = (hi.z - oz) * iz;
-  const float16 tin = max(max(max(min(ax, bx), min(ay, by)), min(az, bz)), (float16)0.0f);
-  const float16 tout = min(min(min(max(ax, bx), max(ay, by)), max(az, bz)), best_t);
-  return select((float16)INFINITY, tin, tin <= tout);
+inline float8 bundle_entry(float4 lo, float4 hi, float8 ox, float8 oy, float8 oz,
+                           float8 ix, float8 iy, float8 iz, float8 best_t) {
+  const float8 ax = (lo.x - ox) * ix, bx = (hi.x - ox) * ix;
+  const float8 ay = (lo.y - oy) * iy, by = (hi.y - oy) * iy;
+  const float8 az = (lo.z - oz) * iz, bz = (hi.z - oz) * iz;
+  const float8 tin = max(max(max(min(ax, bx), min(ay, by)), min(az, bz)), (float8)0.0f);
+  const float8 tout = min(min(min(max(ax, bx), max(ay, by)), max(az, bz)), best_t);
+  return select((float8)INFINITY, tin, tin <= tout);
 }
 
 // Closest hits of the bundle: per lane the hit record (0xffffffff = none) and distance.
 inline void closest_hits_bundle(__global const float4* bvh, __global const float4* tris,
-                                float16 ox, float16 oy, float16 oz, float16 dx, float16 dy,
-                                float16 dz, int16 active, uint16* f_out, float16* t_out) {
+                                float8 ox, float8 oy, float8 oz, float8 dx, float8 dy,
+                                float8 dz, int8 active, uint8* f_out, float8* t_out) {
   const float tiny = 1e-20f;
-  const float16 ix = 1.0f / select(dx, copysign((float16)tiny, dx), fabs(dx) < tiny);
-  const float16 iy = 1.0f / select(dy, copysign((float16)tiny, dy), fabs(dy) < tiny);
-  const float16 iz = 1.0f / select(dz, copysign((float16)tiny, dz), fabs(dz) < tiny);
-  float16 best_t = select((float16)(-1.0f), (float16)INFINITY, active);
-  uint16 best_f = (uint16)0xffffffffu;
+  const float8 ix = 1.0f / select(dx, copysign((float8)tiny, dx), fabs(dx) < tiny);
+  const float8 iy = 1.0f / select(dy, copysign((float8)tiny, dy), fabs(dy) < tiny);
+  const float8 iz = 1.0f / select(dz, copysign((float8)tiny, dz), fabs(dz) < tiny);
+  float8 best_t = select((float8)(-1.0f), (float8)INFINITY, active);
+  uint8 best_f = (uint8)0xffffffffu;
   *f_out = best_f;
   *t_out = best_t;
   uint stack_node[BVH_STACK_SIZE];
@@ -274,7 +294,7 @@ inline void closest_hits_bundle(__global const float4* bvh, __global const float
   int sp = 0;
   uint node = 0;
   {
-    const float16 root = bundle_entry(bvh[0], bvh[1], ox, oy, oz, ix, iy, iz, best_t);
+    const float8 root = bundle_entry(bvh[0], bvh[1], ox, oy, oz, ix, iy, iz, best_t);
     if (!(pair_min(root, root).x < INFINITY)) return;
   }
   for (;;) {
@@ -284,27 +304,30 @@ inline void closest_hits_bundle(__global const float4* bvh, __global const float
       const uint end = word + (count & ~LEAF_BIT);
       for (uint k = word; k < end; ++k) {
         const float4 v0 = tris[3 * k], e1 = tris[3 * k + 1], e2 = tris[3 * k + 2];
-        const float16 px = dy * e2.z - dz * e2.y, py = dz * e2.x - dx * e2.z,
-                      pz = dx * e2.y - dy * e2.x;
-        const float16 det = e1.x * px + e1.y * py + e1.z * pz;
-        const float16 inv_det = 1.0f / det;
-        const float16 tx = ox - v0.x, ty = oy - v0.y, tz = oz - v0.z;
-        const float16 u = (tx * px + ty * py + tz * pz) * inv_det;
-        const float16 qx = ty * e1.z - tz * e1.y, qy = tz * e1.x - tx * e1.z,
-                      qz = tx * e1.y - ty * e1.x;
-        const float16 v = (dx * qx + dy * qy + dz * qz) * inv_det;
-        const float16 t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
-        const int16 hit = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
-                          (u + v <= 1.0f) & (t > 0.0f) & (t < best_t);
+        const float8 px = dy * e2.z - dz * e2.y, py = dz * e2.x - dx * e2.z,
+                     pz = dx * e2.y - dy * e2.x;
+        const float8 det = e1.x * px + e1.y * py + e1.z * pz;
+        const float8 inv_det = 1.0f / det;
+        const float8 tx = ox - v0.x, ty = oy - v0.y, tz = oz - v0.z;
+        const float8 u = (tx * px + ty * py + tz * pz) * inv_det;
+        const float8 qx = ty * e1.z - tz * e1.y, qy = tz * e1.x - tx * e1.z,
+                     qz = tx * e1.y - ty * e1.x;
+        const float8 v = (dx * qx + dy * qy + dz * qz) * inv_det;
+        const float8 t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
+        const int8 hit = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
+                         (u + v <= 1.0f) & (t > 0.0f) & (t < best_t);
         best_t = select(best_t, t, hit);
-        best_f = select(best_f, (uint16)k, as_uint16(hit));
+        best_f = select(best_f, (uint8)k, as_uint8(hit));
       }
     } else {
       const uint a = node + 1, b = word;
-      const float16 ta =
-          bundle_entry(bvh[2 * a], bvh[2 * a + 1], ox, oy, oz, ix, iy, iz, best_t);
-      const float16 tb =
-          bundle_entry(bvh[2 * b], bvh[2 * b + 1], ox, oy, oz, ix, iy, iz, best_t);
+      const float4 alo = bvh[2 * a], ahi = bvh[2 * a + 1], blo = bvh[2 * b], bhi = bvh[2 * b + 1];
+      // Start the loads the next steps will need: a child's second child (its first is next
+      // to it) or a leaf child's first triangle records.
+      sdfkit_prefetch_child(bvh, tris, as_uint(alo.w), as_uint(ahi.w));
+      sdfkit_prefetch_child(bvh, tris, as_uint(blo.w), as_uint(bhi.w));
+      const float8 ta = bundle_entry(alo, ahi, ox, oy, oz, ix, iy, iz, best_t);
+      const float8 tb = bundle_entry(blo, bhi, ox, oy, oz, ix, iy, iz, best_t);
       const float2 m2 = pair_min(ta, tb);
       const float a_min = m2.x, b_min = m2.y;
       const bool hit_a = a_min < INFINITY, hit_b = b_min < INFINITY;
@@ -336,7 +359,10 @@ inline void closest_hits_bundle(__global const float4* bvh, __global const float
   }
 }
 
-// One work item per (bundle, ray); writes the keys of its lanes like trace_rays.
+// One work item per (bundle, ray), ray-major: neighbouring work items trace the same cone
+// direction from neighbouring bundles, so they meet the same nodes and triangles while these
+// are in cache (bundle-major order gave neighbouring work items the other rays of one bundle,
+// whose hits lie all over the far side). Writes the keys of its lanes like trace_rays.
 __kernel void trace_bundles(__global const float4* bvh, __global const float4* tris,
                             __global const float4* points, __global const float4* normals,
                             __global const float4* table, int n_rays, uint n_points,
@@ -344,7 +370,7 @@ __kernel void trace_bundles(__global const float4* bvh, __global const float4* t
   const uint bundles = (n_points + BUNDLE - 1) / BUNDLE;
   const uint g = get_global_id(0);
   if (g >= bundles * (uint)n_rays) return;
-  const uint bundle = g / (uint)n_rays, r = g - bundle * (uint)n_rays;
+  const uint r = g / bundles, bundle = g - r * bundles;
   const uint first = bundle * BUNDLE, lanes = min((uint)BUNDLE, n_points - first);
   const float3 cone_dir = table[r].xyz;
   float oxs[BUNDLE], oys[BUNDLE], ozs[BUNDLE], dxs[BUNDLE], dys[BUNDLE], dzs[BUNDLE];
@@ -359,15 +385,15 @@ __kernel void trace_bundles(__global const float4* bvh, __global const float4* t
     dxs[l] = d.x; dys[l] = d.y; dzs[l] = d.z;
     act[l] = (l < lanes && pt.w != 0.0f) ? -1 : 0;
   }
-  uint16 f16;
-  float16 t16;
-  closest_hits_bundle(bvh, tris, vload16(0, oxs), vload16(0, oys), vload16(0, ozs),
-                      vload16(0, dxs), vload16(0, dys), vload16(0, dzs), vload16(0, act), &f16,
-                      &t16);
+  uint8 f8;
+  float8 t8;
+  closest_hits_bundle(bvh, tris, vload8(0, oxs), vload8(0, oys), vload8(0, ozs),
+                      vload8(0, dxs), vload8(0, dys), vload8(0, dzs), vload8(0, act), &f8,
+                      &t8);
   uint fs[BUNDLE];
   float ts[BUNDLE];
-  vstore16(f16, 0, fs);
-  vstore16(t16, 0, ts);
+  vstore8(f8, 0, fs);
+  vstore8(t8, 0, ts);
   for (uint l = 0; l < lanes; ++l) {
     const uint p = first + l;
     ulong key = NO_HIT_KEY;

@@ -101,11 +101,11 @@ void set_args(cl_kernel kernel, const char* kernel_name, const Args&... args) {
 // Work-group size on CPU devices when the configuration leaves it open: PoCL's own choice left
 // one of two cores idle at the end of small launches (elephant, 2775 points x 25 rays: 20-23 ms
 // of trace and gather against 14-15 ms with 16-64, then with one point's packet per work item).
-// A bundle work item traces 16 rays, so groups of 8: CGAL's hand at 4 rays (the skeleton's
+// A bundle work item traced 16 rays (now 8), so groups of 8: CGAL's hand at 4 rays (the skeleton's
 // contraction calls) 1.5 -> 0.8 ms, elephant 3.6 -> 1.9 ms; at 30 rays no change.
 constexpr std::size_t kCpuWorkGroup = 8;
-// Points per work item of trace_bundles (sdf_definition_shared.h).
-constexpr std::size_t kBundle = SDFKIT_BUNDLE_WIDTH;
+// Points per work item of trace_bundles (cl/sdf_trace.cl, given as SDFKIT_BUNDLE_WIDTH).
+constexpr std::size_t kBundle = 8;
 // Most points per batch on CPU devices, whose buffers are host memory beside the process's own:
 // 2^17 points at 30 rays are 35 MiB of batch buffers instead of the 512 MiB cap (2^18 held
 // another 35 MiB at the 13M-triangle run's peak), and a batch still traces for about a second
@@ -261,7 +261,9 @@ void OpenClBackend::Impl::build_program() {
   // A node pops one entry and pushes at most 8 children: 7 per level plus the root.
   const int stack = 7 * std::max(config.octree_max_depth, 1) + 2;
   std::string options = "-cl-std=CL1.2 -DSTACK_SIZE=" + std::to_string(stack);
-  if (config.accel == Accel::Bvh) options += " -DSDFKIT_BVH=1";
+  if (config.accel == Accel::Bvh) options += " -DSDFKIT_BVH=1 -DSDFKIT_BUNDLE_WIDTH=" + std::to_string(kBundle);
+  // CPU devices: software prefetches in the bundle traversal (cl/sdf_trace.cl).
+  if (info.type == "CPU") options += " -DSDFKIT_PREFETCH=1";
   cl_device_fp_config fp = 0;
   check(clGetDeviceInfo(device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, nullptr),
         "querying the device's float support");

@@ -108,7 +108,7 @@ TEST_P(OpenClVsEmbreeSmall, PointsAgreeWhereTheSameRaysAreKept) {
 INSTANTIATE_TEST_SUITE_P(CgalMeshes, OpenClVsEmbreeSmall,
                          ::testing::Values("cube-ouvert.off", "degtri_sliding.off"), param_name);
 
-// Bundles (16 points per ray) and single rays trace the same rays with the same triangle test:
+// Bundles (8 points per ray) and single rays trace the same rays with the same triangle test:
 // the same lengths up to rounding (the single-ray test may contract into fma), except that a
 // ray through a shared edge may take the other face at the same distance (and so get the
 // other false-hit verdict).

@@ -46,9 +46,6 @@
 #define SDFKIT_RULE_PAPER 0u
 #define SDFKIT_RULE_CGAL 1u
 
-/* OpenCL bundles: rays of this many Morton-neighbouring points traced together (float16). */
-#define SDFKIT_BUNDLE_WIDTH 16
-
 /* Depth-peeling layer images and fragment lists: a depth (normalised, 0..1) of SDFKIT_NO_SURFACE
  * marks a texel where nothing was drawn; any depth from SDFKIT_NO_SURFACE_BELOW up counts as
  * none (sub-pixel corrected depths stay below 1 + 2 / 16). */

@@ -57,10 +57,10 @@ struct OpenClConfig {
   int octree_max_depth = 10;
   int octree_leaf_size = 8;
   // BVH: the triangle count under which the SAH may stop splitting, and a node visit's cost in
-  // triangle tests; 0 = by tracer: bundles 16 and 3 (a bundle's node visit is two 16-lane box
-  // tests and a reduction, about three of its triangle tests: elephant / armadillo / bunny00 at
-  // 30 rays 12.1 / 162 / 212 ms with 4 and 1, 10.5 / 150 / 200 ms with 16 and 3), single rays
-  // 4 and 1.
+  // triangle tests; 0 = by tracer: bundles 16 and 3 (a bundle's node visit is two box tests
+  // of its lanes and a reduction, about three of its triangle tests: elephant / armadillo /
+  // bunny00 at 30 rays 12.1 / 162 / 212 ms with 4 and 1, 10.5 / 150 / 200 ms with 16 and 3,
+  // measured with 16-lane bundles), single rays 4 and 1.
   int bvh_leaf_size = 0;
   float bvh_traversal_cost = 0.0f;
   // BVH: update_positions refits the tree (new boxes, same tree: O(n) instead of a build) while
@@ -68,14 +68,14 @@ struct OpenClConfig {
   // that was degenerate at the build is not any more, it rebuilds. 0 = always rebuild. The
   // skeleton's contraction moves vertices every iteration: measured in engine/opencl/README.md.
   double bvh_refit_limit = 1.25;
-  // BVH: trace ray r of 16 neighbouring points (Morton order) together as one float16 bundle
+  // BVH: trace ray r of 8 neighbouring points (Morton order) together as one float8 bundle
   // per work item (SIMD on CPU devices: nearly parallel rays from nearby origins, every lane
   // busy) instead of one ray per work item. Unset: bundles on CPU devices, single rays on GPUs
   // (whose work items are scalar lanes already).
   std::optional<bool> bvh_bundles;
   // Work-group size of the trace and gather kernels; 0 = 8 on CPU devices (measured: the
   // driver's choice left a core idle at the end of small launches, and a bundle work item
-  // traces 16 rays, so small groups balance the skeleton's small calls), the driver's on GPUs.
+  // traces several rays, so small groups balance the skeleton's small calls), the driver's on GPUs.
   std::size_t work_group_size = 0;
 };
 
