@@ -8,6 +8,24 @@
 #include <memory>
 
 namespace sdfkit::cli {
+namespace {
+
+// What both forms of `info` report first: the file and its counts before and after welding.
+nlohmann::json counts_json(const io::Asset& asset) {
+  return {{"file", asset.path},
+          {"vertices", asset.input_positions.size()},
+          {"faces", asset.input_triangles.size()},
+          {"welded_vertices", asset.mesh.positions.size()}};
+}
+
+void print_counts(const io::Asset& asset) {
+  std::printf("file:               %s\n", asset.path.c_str());
+  std::printf("vertices:           %zu\n", asset.input_positions.size());
+  std::printf("faces:              %zu\n", asset.input_triangles.size());
+  std::printf("welded vertices:    %zu\n", asset.mesh.positions.size());
+}
+
+}  // namespace
 
 void add_info_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Print counts and topology of a mesh");
@@ -30,29 +48,20 @@ void add_info_command(CLI::App& app) {
     if (*load_only) {
       nlohmann::json times = nlohmann::json::object();
       for (const StageTiming& s : asset.load_stages) times[s.stage] = s.milliseconds;
-      const nlohmann::json j = {{"file", asset.path},
-                                {"vertices", asset.input_positions.size()},
-                                {"faces", asset.input_triangles.size()},
-                                {"welded_vertices", asset.mesh.positions.size()},
-                                {"time_ms", times}};
+      nlohmann::json j = counts_json(asset);
+      j["time_ms"] = times;
       if (*json) {
         std::printf("%s\n", j.dump(2).c_str());
         return;
       }
-      std::printf("file:               %s\n", asset.path.c_str());
-      std::printf("vertices:           %zu\n", asset.input_positions.size());
-      std::printf("faces:              %zu\n", asset.input_triangles.size());
-      std::printf("welded vertices:    %zu\n", asset.mesh.positions.size());
+      print_counts(asset);
       for (const StageTiming& s : asset.load_stages) std::printf("%-20s%.1f ms\n", (s.stage + ":").c_str(), s.milliseconds);
       return;
     }
     const MeshReport r = analyze(asset.mesh);
     if (*json) {
-      nlohmann::json j = {
-          {"file", asset.path},
-          {"vertices", asset.input_positions.size()},
-          {"faces", asset.input_triangles.size()},
-          {"welded_vertices", asset.mesh.positions.size()},
+      nlohmann::json j = counts_json(asset);
+      j.update({
           {"bounds", {{"min", {r.bounds.min.x, r.bounds.min.y, r.bounds.min.z}},
                       {"max", {r.bounds.max.x, r.bounds.max.y, r.bounds.max.z}}}},
           {"diagonal", r.bounds.diagonal()},
@@ -62,14 +71,11 @@ void add_info_command(CLI::App& app) {
           {"degenerate_faces", r.degenerate_faces},
           {"isolated_vertices", r.isolated_vertices},
           {"closed", r.boundary_edges == 0 && r.non_manifold_edges == 0},
-          {"warnings", asset.warnings}};
+          {"warnings", asset.warnings}});
       std::printf("%s\n", j.dump(2).c_str());
       return;
     }
-    std::printf("file:               %s\n", asset.path.c_str());
-    std::printf("vertices:           %zu\n", asset.input_positions.size());
-    std::printf("faces:              %zu\n", asset.input_triangles.size());
-    std::printf("welded vertices:    %zu\n", asset.mesh.positions.size());
+    print_counts(asset);
     std::printf("bounding box:       [%g, %g, %g] .. [%g, %g, %g] (diagonal %g)\n", r.bounds.min.x,
                 r.bounds.min.y, r.bounds.min.z, r.bounds.max.x, r.bounds.max.y, r.bounds.max.z,
                 r.bounds.diagonal());

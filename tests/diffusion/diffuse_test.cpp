@@ -46,6 +46,20 @@ std::vector<float> test_field(const Mesh& m, unsigned seed = 7) {
   return u;
 }
 
+// An n × n grid of unit squares in the plane z = 0, vertex (i, j) at (i, j, 0), index j·n + i.
+Mesh unit_grid(int n) {
+  Mesh m;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) m.positions.push_back({static_cast<float>(i), static_cast<float>(j), 0.0f});
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const auto v = static_cast<std::uint32_t>(j * n + i), w = static_cast<std::uint32_t>(n);
+      m.triangles.push_back({v, v + 1, v + w + 1});
+      m.triangles.push_back({v, v + w + 1, v + w});
+    }
+  return m;
+}
+
 DiffuseOptions sigma_of(float sigma, bool keep_atlas = false) {
   DiffuseOptions o;
   o.sigma = sigma;
@@ -404,15 +418,7 @@ TEST_F(Diffuse, MatchesHeatDiffusionOnACylinder) {
 // (1.37 texels per edge) spreads the vertices over all fractions of a texel.
 TEST_F(Diffuse, TheRoadAroundTheBlurAddsTheDerivedVariance) {
   const int n = 34;
-  Mesh m;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) m.positions.push_back({static_cast<float>(i), static_cast<float>(j), 0.0f});
-  for (int j = 0; j + 1 < n; ++j)
-    for (int i = 0; i + 1 < n; ++i) {
-      const auto v = static_cast<std::uint32_t>(j * n + i), w = static_cast<std::uint32_t>(n);
-      m.triangles.push_back({v, v + 1, v + w + 1});
-      m.triangles.push_back({v, v + w + 1, v + w});
-    }
+  const Mesh m = unit_grid(n);
   EXPECT_NEAR(interpolation_variance(m), 1.0 / 6.0, 1e-9);  // legs 1, 1 and a diagonal: (1 + 1 + 2) / 24
   const float tpu = 1.37f;
   AtlasMapping a;
@@ -477,15 +483,7 @@ TEST_F(Diffuse, TheRoadAroundTheBlurAddsTheDerivedVariance) {
 // 1.93).
 TEST_F(Diffuse, StretchCompensationUsesEachAxisOwnScale) {
   const int n = 34;
-  Mesh m;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) m.positions.push_back({static_cast<float>(i), static_cast<float>(j), 0.0f});
-  for (int j = 0; j + 1 < n; ++j)
-    for (int i = 0; i + 1 < n; ++i) {
-      const auto v = static_cast<std::uint32_t>(j * n + i), w = static_cast<std::uint32_t>(n);
-      m.triangles.push_back({v, v + 1, v + w + 1});
-      m.triangles.push_back({v, v + w + 1, v + w});
-    }
+  const Mesh m = unit_grid(n);
   const float sx = 1.37f, sy = 2.9f;
   AtlasMapping a;
   a.size = 128;
