@@ -60,6 +60,21 @@ Mesh unit_grid(int n) {
   return m;
 }
 
+// The mean of out - u over the vertices of unit_grid(n) at least `margin` from its border: what a
+// blur added to a quadratic u there (its variance along each axis u grows in).
+double interior_gain(const Mesh& m, int n, float margin, const std::vector<float>& out, const std::vector<float>& u) {
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t v = 0; v < u.size(); ++v) {
+    const glm::vec3 p = m.positions[v];
+    if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
+    sum += static_cast<double>(out[v]) - u[v];
+    ++count;
+  }
+  EXPECT_GT(count, 50);
+  return sum / std::max(count, 1);
+}
+
 DiffuseOptions sigma_of(float sigma, bool keep_atlas = false) {
   DiffuseOptions o;
   o.sigma = sigma;
@@ -437,17 +452,7 @@ TEST_F(Diffuse, TheRoadAroundTheBlurAddsTheDerivedVariance) {
   for (float sigma : {1.5f, 2.5f}) {
     // The measured variance per axis of the whole road: (read-back - u) / 2 away from the borders.
     const auto measure = [&](const DiffuseResult& r) {
-      double sum = 0.0;
-      int count = 0;
-      const float margin = 4.0f * sigma + 1.0f;
-      for (std::size_t v = 0; v < u.size(); ++v) {
-        const glm::vec3 p = m.positions[v];
-        if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
-        sum += (static_cast<double>(r.values[v]) - u[v]) / 2.0;
-        ++count;
-      }
-      EXPECT_GT(count, 50);
-      return sum / std::max(count, 1);
+      return interior_gain(m, n, 4.0f * sigma + 1.0f, r.values, u) / 2.0;
     };
     // One width per chart: integer boxes from the plan.
     DiffuseOptions per_chart = sigma_of(sigma);
@@ -506,17 +511,7 @@ TEST_F(Diffuse, StretchCompensationUsesEachAxisOwnScale) {
     DiffuseOptions o = sigma_of(sigma);
     o.stretch = stretch;
     const DiffuseResult r = diffuser_->run(m, a, u, o);
-    double sum = 0.0;
-    int count = 0;
-    const float margin = 4.0f * sigma + 1.0f;
-    for (std::size_t v = 0; v < u.size(); ++v) {
-      const glm::vec3 p = m.positions[v];
-      if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
-      sum += static_cast<double>(r.values[v]) - u[v];
-      ++count;
-    }
-    EXPECT_GT(count, 50);
-    return sum / std::max(count, 1);
+    return interior_gain(m, n, 4.0f * sigma + 1.0f, r.values, u);
   };
   const double s2 = sigma * sigma;
   const double vx = variance(ux, true), vy = variance(uy, true), fx = variance(ux, false), fy = variance(uy, false);
