@@ -89,17 +89,11 @@ void main() {
   if (j >= pc.job_count) return;
   const uvec2 job = jobs[pc.job_offset + j];
   const Chart c = charts[job.x];
-  if (pc.axis == 0u) {
-    g_origin = uvec2(c.rect.x, c.rect.y + job.y);
-    g_step = uvec2(1u, 0u);
-    g_n = int(c.rect.z);
-    g_wrap = c.params.w != 0u;
-  } else {
-    g_origin = uvec2(c.rect.x + job.y, c.rect.y);
-    g_step = uvec2(0u, 1u);
-    g_n = int(c.rect.w);
-    g_wrap = false;
-  }
+  const ChartLine line = chart_line(c, job.y, pc.axis);
+  g_origin = line.origin;
+  g_step = line.step;
+  g_n = line.n;
+  g_wrap = line.wrap;
   const int r0 = int(c.params.x), r1 = int(c.params.y), r2 = int(c.params.z);
   const float norm0 = 1.0 / float(2 * r0 + 1), norm1 = 1.0 / float(2 * r1 + 1), norm2 = 1.0 / float(2 * r2 + 1);
   g_period_shift = g_n * ((r0 + r1 + r2 + 1) / g_n + 1);

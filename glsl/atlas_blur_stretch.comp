@@ -105,17 +105,11 @@ void main() {
   if (j >= pc.job_count) return;
   const uvec2 job = jobs[pc.job_offset + j];
   const Chart c = charts[job.x];
-  if (pc.axis == 0u) {
-    g_origin = uvec2(c.rect.x, c.rect.y + job.y);
-    g_step = uvec2(1u, 0u);
-    g_n = int(c.rect.z);
-    g_wrap = c.params.w != 0u;
-  } else {
-    g_origin = uvec2(c.rect.x + job.y, c.rect.y);
-    g_step = uvec2(0u, 1u);
-    g_n = int(c.rect.w);
-    g_wrap = false;
-  }
+  const ChartLine line = chart_line(c, job.y, pc.axis);
+  g_origin = line.origin;
+  g_step = line.step;
+  g_n = line.n;
+  g_wrap = line.wrap;
   g_fallback = max(stretch_half_width(c.metric.x, pc.variance), 0.0);
   g_cap = g_wrap ? (g_n - 1) / 2 : g_n;
   // Walk 1: S(k) = sum of the line's texels 0..k, compensated: sum - comp is the exact sum to

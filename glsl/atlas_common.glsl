@@ -6,6 +6,20 @@ struct Chart {
   vec4 metric;   // x: the chart's mean model units per texel
 };
 
+// Line `line` of chart c along `axis` (0: a row, which wraps where the chart does; 1: a column,
+// which never wraps), as the blur passes walk it: its first texel, the step between texels, its
+// length.
+struct ChartLine {
+  uvec2 origin;
+  uvec2 step;
+  int n;
+  bool wrap;
+};
+ChartLine chart_line(Chart c, uint line, uint axis) {
+  if (axis == 0u) return ChartLine(uvec2(c.rect.x, c.rect.y + line), uvec2(1u, 0u), int(c.rect.z), c.params.w != 0u);
+  return ChartLine(uvec2(c.rect.x + line, c.rect.y), uvec2(0u, 1u), int(c.rect.w), false);
+}
+
 // The stretch-compensated blur's box half-width h = f + a (texels; f integer, 0 <= a < 1) where
 // the map has m model units per texel along the axis, for a Gaussian whose variance left for the
 // blur is `variance` (model units²): each of the three boxes gets a third of variance / m² less
