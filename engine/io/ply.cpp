@@ -387,6 +387,17 @@ void read_binary(const std::string& path, const PlyHeader& h, std::int64_t verte
     const bool fast_face = is_face && e.properties.size() == 1 && e.properties[0].count_type == PlyType::UInt8 &&
                            (e.properties[0].type == PlyType::Int32 || e.properties[0].type == PlyType::UInt32);
     const auto vmax = static_cast<std::uint64_t>(vertex_count);
+    // A "3 a b c" row's three 32-bit indices from `at` into t; false when one is out of range
+    // (a negative int32 is >= 2^31 here).
+    const auto plain_indices = [&](const char* at, Triangle& t) {
+      bool ok = true;
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = load_raw<std::uint32_t>(at + 4 * k, swap);
+        ok = ok && v < vmax;
+        t[static_cast<std::size_t>(k)] = v;
+      }
+      return ok;
+    };
     // Rows that are all "3 a b c" (the usual binary triangle mesh) lie 13 bytes apart: then
     // they are decoded on all threads. Row k's count is read at pos + 13 k, which is where row
     // k starts when rows 0..k-1 all hold 3; any other count or an index out of range sends the
@@ -400,13 +411,7 @@ void read_binary(const std::string& path, const PlyHeader& h, std::int64_t verte
         bool ok = true;
         for (std::size_t row = b; row < end && ok; ++row) {
           const char* r = rows + row * 13;
-          ok = static_cast<unsigned char>(r[0]) == 3;
-          Triangle& t = out.triangles[first + row];
-          for (int k = 0; k < 3; ++k) {
-            const std::uint32_t v = load_raw<std::uint32_t>(r + 1 + 4 * k, swap);
-            ok = ok && v < vmax;
-            t[static_cast<std::size_t>(k)] = v;
-          }
+          ok = static_cast<unsigned char>(r[0]) == 3 && plain_indices(r + 1, out.triangles[first + row]);
         }
         if (!ok) plain = false;
         else if (file) file->release(pos + b * 13, pos + end * 13);
@@ -421,13 +426,7 @@ void read_binary(const std::string& path, const PlyHeader& h, std::int64_t verte
     for (std::size_t row = 0; row < count; ++row) {
       if (fast_face && pos + 13 <= end_of_data && static_cast<unsigned char>(d[pos]) == 3) {
         Triangle t;
-        bool ok = true;
-        for (int k = 0; k < 3; ++k) {
-          const std::uint32_t v = load_raw<std::uint32_t>(d + pos + 1 + 4 * k, swap);
-          ok = ok && v < vmax;  // a negative int32 is >= 2^31 here
-          t[static_cast<std::size_t>(k)] = v;
-        }
-        if (!ok) {
+        if (!plain_indices(d + pos + 1, t)) {
           for (int k = 0; k < 3; ++k) {
             const std::int64_t v = load_index(d + pos + 1 + 4 * k, e.properties[0].type, swap);
             if (v < 0 || v >= vertex_count)
