@@ -187,7 +187,9 @@ struct OpenClBackend::Impl {
   std::size_t vertex_count = 0, face_count = 0;
   bool has_mesh = false;
   Octree octree;
-  Bvh bvh;  // nodes empty between a build and the next refit (see read_back_nodes)
+  Bvh bvh;  // nodes empty after set_mesh until the first refit (see read_back_nodes)
+  std::vector<glm::vec4> staging;  // the triangle records of a deferred upload (update_positions)
+  bool upload_pending = false;     // a deferred upload may still read `bvh.nodes` and `staging`
   std::size_t bvh_node_count = 0;
   double built_sah = 0.0;  // sah_cost of the last full build
   bool refitted = false;   // the last geometry update refit the BVH instead of building it
@@ -203,6 +205,10 @@ struct OpenClBackend::Impl {
 
   double octree_ms = 0.0, upload_ms = 0.0, trace_ms = 0.0;
 
+  // A deferred upload reads host memory of this object: it must end before that memory does.
+  ~Impl() {
+    if (upload_pending) clFinish(queue.get());
+  }
   void create(const OpenClConfig& cfg);
   void build_program();
   detail::Kernel make_kernel(const char* name);
@@ -308,6 +314,12 @@ void OpenClBackend::Impl::run(cl_kernel kernel, std::size_t items, std::size_t l
 // Host: builds the octree and the per-face records; device: uploads them into buffers that
 // only grow, so moving vertices reuses the allocations.
 void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_moved) {
+  // The host copies the last deferred upload reads (BVH nodes, `staging`) are rewritten below.
+  if (upload_pending) finish("uploading the moved mesh");
+  upload_pending = false;
+  // update_positions with a BVH (the skeleton's contraction: small meshes, one update per
+  // iteration) keeps the nodes and records on the host and does not wait for their upload.
+  const bool deferred = positions_moved && config.accel == Accel::Bvh;
   auto start = std::chrono::steady_clock::now();
   // The triangle list of the leaves, leaf by leaf (octree: a triangle once per leaf it touches).
   const std::vector<std::uint32_t>* order = nullptr;
@@ -341,26 +353,22 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
     nodes.reserve(ctx, 16, CL_MEM_READ_ONLY, "unused octree nodes");
     write(cells.get(), bytes_of(bvh.nodes), bvh.nodes.data(), "BVH nodes");
     bvh_node_count = bvh.nodes.size();
-    // The device has the nodes: the host copy goes before the triangle records are mapped
-    // (read_back_nodes brings it back for a refit).
-    finish("uploading the BVH nodes");
-    bvh.nodes = std::vector<BvhNode>();
+    if (!deferred) {
+      // set_mesh: the device has the nodes; the host copy goes before the triangle records are
+      // mapped (read_back_nodes brings it back for a refit).
+      finish("uploading the BVH nodes");
+      bvh.nodes = std::vector<BvhNode>();
+    }
   } else {
     nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
     cells.reserve(ctx, bytes_of(octree.cells), CL_MEM_READ_ONLY, "octree cells");
     write(nodes.get(), bytes_of(octree.nodes), octree.nodes.data(), "octree nodes");
     write(cells.get(), bytes_of(octree.cells), octree.cells.data(), "octree cells");
   }
-  // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w; written
-  // straight into the mapped device buffer (no host copy of 48 bytes per triangle beside it).
+  // One record per leaf reference, in leaf order: v0, e1, e2 with the normal in w.
   const std::size_t record_bytes = 3 * order->size() * sizeof(glm::vec4);
   tris.reserve(ctx, std::max<std::size_t>(record_bytes, 16), CL_MEM_READ_ONLY, "triangles");
-  if (record_bytes > 0) {
-    cl_int err = CL_SUCCESS;
-    void* mapped = clEnqueueMapBuffer(queue.get(), tris.get(), CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0,
-                                      record_bytes, 0, nullptr, nullptr, &err);
-    check(err, "mapping the triangle buffer");
-    auto* records = static_cast<glm::vec4*>(mapped);
+  const auto fill_records = [&](glm::vec4* records) {
     parallel_for(order->size(), [&](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
         const std::uint32_t f = (*order)[k];
@@ -373,10 +381,29 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
         records[3 * k + 2] = glm::vec4(c - a, nf.z);
       }
     }, 1 << 16);
-    check(clEnqueueUnmapMemObject(queue.get(), tris.get(), mapped, 0, nullptr, nullptr),
-          "unmapping the triangle buffer");
+  };
+  if (deferred) {
+    // update_positions with a BVH: the records go through a host copy kept with the nodes, and
+    // nothing waits here; the next compute's blocking read (or the next update) finds them done.
+    staging.resize(3 * order->size());
+    fill_records(staging.data());
+    write(tris.get(), record_bytes, staging.data(), "triangles");
+    upload_pending = true;
+  } else {
+    // set_mesh: written straight into the mapped device buffer (no host copy of 48 bytes per
+    // triangle beside it).
+    staging = std::vector<glm::vec4>();
+    if (record_bytes > 0) {
+      cl_int err = CL_SUCCESS;
+      void* mapped = clEnqueueMapBuffer(queue.get(), tris.get(), CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0,
+                                        record_bytes, 0, nullptr, nullptr, &err);
+      check(err, "mapping the triangle buffer");
+      fill_records(static_cast<glm::vec4*>(mapped));
+      check(clEnqueueUnmapMemObject(queue.get(), tris.get(), mapped, 0, nullptr, nullptr),
+            "unmapping the triangle buffer");
+    }
+    finish("uploading the mesh");
   }
-  finish("uploading the mesh");
   upload_ms = ms_since(start);
   geometry_bytes = nodes.size() + cells.size() + tris.size();
 }
@@ -515,14 +542,20 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
   // Points are traced in Morton order of their origins (neighbouring work items meet the same
   // nodes and triangles, which keeps them in cache); the results go back to query order.
   const std::vector<std::uint32_t> order = spatial_order(query.origins);
-  // One batch of points and normals at a time (not a second copy of the whole query): the
-  // blocking writes wait for the previous batch's kernels, which read the same buffers.
+  // One batch of points and normals at a time (not a second copy of the whole query): each
+  // batch ends with a blocking read, so the next batch's writes find the buffers free.
   std::vector<glm::vec4> pts(batch), nrm(batch);
   // The results come back a batch at a time and go straight to their points (no second pair
   // of per-point arrays in Morton order).
   std::vector<float> values(batch);
   std::vector<std::uint32_t> kept(batch);
   const cl_int rule = static_cast<cl_int>(options.false_hit);
+  // The writes and the first read do not block: should a later call throw, the queue is drained
+  // before the host arrays they use go away (declared after them, destroyed before them).
+  struct Drain {
+    cl_command_queue queue;
+    ~Drain() { clFinish(queue); }
+  } drain{m.queue.get()};
   for (std::size_t first = 0; first < n; first += batch) {
     const std::size_t count = std::min(batch, n - first);
     const auto count32 = static_cast<cl_uint>(count);
@@ -533,10 +566,12 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
         nrm[i] = glm::vec4(query.normals[q], 0.0f);
       }
     }, 1 << 16);
-    check(clEnqueueWriteBuffer(m.queue.get(), m.points.get(), CL_TRUE, 0, count * sizeof(cl_float4), pts.data(), 0,
+    // Non-blocking: the in-order queue runs them before the kernels, and the blocking read that
+    // ends this batch returns only when they are done, before `pts` and `nrm` are refilled.
+    check(clEnqueueWriteBuffer(m.queue.get(), m.points.get(), CL_FALSE, 0, count * sizeof(cl_float4), pts.data(), 0,
                                nullptr, nullptr),
           "uploading query points");
-    check(clEnqueueWriteBuffer(m.queue.get(), m.normals.get(), CL_TRUE, 0, count * sizeof(cl_float4), nrm.data(), 0,
+    check(clEnqueueWriteBuffer(m.queue.get(), m.normals.get(), CL_FALSE, 0, count * sizeof(cl_float4), nrm.data(), 0,
                                nullptr, nullptr),
           "uploading query normals");
     if (m.bundles) {
@@ -567,6 +602,7 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
     }
   }
   m.finish("tracing rays");
+  m.upload_pending = false;
   m.trace_ms = ms_since(start);
   return raw;
 }

@@ -105,6 +105,11 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
         backend_has_mesh = true;
         sdf_options.rays = it > 0 && options.iteration_rays > 0 ? options.iteration_rays : options.sdf.rays;
         values = compute_sdf(*backend, current, sdf_options).values;
+        if (log_level() <= LogLevel::Debug) {
+          std::string stages;
+          for (const StageTiming& st : backend->last_timings()) stages += " " + st.stage + " " + std::to_string(st.milliseconds);
+          log_debug("contraction SDF stages (ms):" + stages);
+        }
       }
       if (it == 0) {
         result.first_sdf = values;

@@ -380,8 +380,13 @@ detail::CurveGraph surgery(const Surface& surface, const std::vector<float>& loc
   return graph;
 }
 
-Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
-               const SkeletonOptions& options, const ContractedProxy* proxy, bool keep_handles) {
+// `surface`: Surface(original, contracted, sdf), built once for both of build_keeping_handles'
+// calls (it depends only on those three).
+Skeleton build(const Surface& surface, const SkeletonOptions& options, const ContractedProxy* proxy,
+               bool keep_handles) {
+  const Mesh& original = surface.original;
+  const Mesh& contracted = surface.contracted;
+  const std::vector<float>& sdf = surface.sdf;
   const std::size_t n = original.positions.size();
 
   const double diag = bounding_box(original.positions).diagonal();
@@ -396,12 +401,10 @@ Skeleton build(const Mesh& original, const Mesh& contracted, const std::vector<f
   so.grouping_local = options.gmt;
   so.keep_handles = keep_handles;
   Stopwatch watch;
-  const Surface surface(original, contracted, sdf);
   // Grouping never joins nodes whose segment leaves the solid (a head grouped with the feet).
   so.segment_inside = [&surface](const glm::vec3& a, const glm::vec3& b) {
     return !surface.bvh.segment_blocked(a, b) && surface.bvh.inside(a);
   };
-  watch.lap("BVH and centre points");
   detail::CurveGraph graph = surgery(surface, local_radius, proxy, so);
   watch.lap("connectivity surgery");
 
@@ -1343,11 +1346,14 @@ int total_genus(const Mesh& mesh) {
 // nearer the genus is kept (the plain one on a tie). Deterministic: both runs are.
 Skeleton build_keeping_handles(const Mesh& original, const Mesh& contracted, const std::vector<float>& sdf,
                                const SkeletonOptions& options, const ContractedProxy* proxy) {
-  Skeleton plain = build(original, contracted, sdf, options, proxy, false);
+  Stopwatch watch;
+  const Surface surface(original, contracted, sdf);
+  watch.lap("BVH and centre points");
+  Skeleton plain = build(surface, options, proxy, false);
   const int genus = total_genus(original);
   const int plain_cycles = cycle_count(plain);
   if (plain_cycles >= genus) return plain;
-  Skeleton guarded = build(original, contracted, sdf, options, proxy, true);
+  Skeleton guarded = build(surface, options, proxy, true);
   const int guarded_cycles = cycle_count(guarded);
   log_debug("skeleton: " + std::to_string(plain_cycles) + " cycles for genus " + std::to_string(genus) +
             "; with the surgery's handle guard " + std::to_string(guarded_cycles));

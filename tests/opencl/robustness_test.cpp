@@ -151,6 +151,40 @@ TEST_P(OpenClUpdate, UpdatePositionsEqualsFreshSetMesh) {
   EXPECT_THROW(backend.update_positions(std::vector<glm::vec3>(3)), Error);
 }
 
+// The skeleton's contraction: one update_positions per iteration, each refitting the tree of
+// the last (kept on the host; its upload is not waited for). Two updates in a row, without a
+// compute between them, give the values of the same updates each followed by a compute.
+TEST_P(OpenClUpdate, UpdatesInARowEqualUpdatesEachComputed) {
+  SDFKIT_REQUIRE_CL_ACCEL(backend, GetParam());
+  const Mesh base = shapes::capsule(1.0f, 3.0f, 40, 20);
+  SdfOptions o;
+  o.rays = 4;
+  std::vector<Mesh> steps;
+  for (int step = 1; step <= 6; ++step) {
+    const float s = 1.0f - 0.08f * static_cast<float>(step);  // shrinks toward the axis
+    Mesh m = base;
+    for (glm::vec3& p : m.positions) p = glm::vec3(p.x * s, p.y * s * s, p.z);
+    steps.push_back(std::move(m));
+  }
+  std::vector<RawSdf> each;
+  backend.set_mesh(base);
+  for (const Mesh& m : steps) {
+    backend.update_positions(m.positions);
+    each.push_back(backend.compute(make_query(m, SdfDomain::Vertex), o));
+  }
+  backend.set_mesh(base);
+  std::size_t compared = 0;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    backend.update_positions(steps[i].positions);
+    if (i % 3 == 0) continue;  // two updates before the next compute
+    const RawSdf updated = backend.compute(make_query(steps[i], SdfDomain::Vertex), o);
+    EXPECT_EQ(updated.values, each[i].values) << "step " << i;
+    EXPECT_EQ(updated.kept_rays, each[i].kept_rays) << "step " << i;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 4u);
+}
+
 // update_positions refits the BVH for a small move, rebuilds it for a distortion that would
 // leave a refit tree much worse than a new one, and rebuilds when a degenerate triangle gets an
 // area; every way gives the values of a fresh set_mesh.
