@@ -1,27 +1,5 @@
 #version 450
-// Atlas raster, fragment stage: (value, coverage 1) and, from the triangle's stretch (model units
-// per texel along x, y), the stretch-compensated blur's box half-widths along x and y there
-// (stretch_half_width), only inside the triangle's own chart rectangle (a triangle across a
-// wrapping chart's seam is drawn once per side and clipped here).
+// Atlas raster, fragment stage: value, coverage and the stretch-compensated blur's box
+// half-widths (two colour attachments; atlas_raster_frag.glsl).
 #extension GL_GOOGLE_include_directive : require
-#include "atlas_common.glsl"
-
-layout(std430, binding = 0) readonly buffer Charts { Chart charts[]; };
-
-layout(location = 0) in float in_value;
-layout(location = 1) flat in uint in_chart;
-layout(location = 2) flat in vec2 in_stretch;
-layout(location = 0) out vec2 out_texel;
-layout(location = 1) out vec2 out_half_width;
-
-layout(push_constant) uniform Push {
-  vec4 scale;  // x: 2 / atlas size (the vertex stage's), y: the blur's variance, model units²
-} pc;
-
-void main() {
-  const uvec4 r = charts[in_chart].rect;
-  const uvec2 p = uvec2(gl_FragCoord.xy);
-  if (p.x < r.x || p.y < r.y || p.x >= r.x + r.z || p.y >= r.y + r.w) discard;
-  out_texel = vec2(in_value, 1.0);
-  out_half_width = vec2(stretch_half_width(in_stretch.x, pc.scale.y), stretch_half_width(in_stretch.y, pc.scale.y));
-}
+#include "atlas_raster_frag.glsl"

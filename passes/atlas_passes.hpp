@@ -74,11 +74,12 @@ struct DilatePush {  // atlas_dilate.comp
 };
 
 // Rasterizes `vertex_count` RasterVertex corners into `target` (RG32F, cleared to 0: value,
-// coverage) and `stretch_target` (RG32F, cleared to -1: the stretch-compensated blur's box
-// half-widths along x and y for `variance`, from the covering triangle's stretch;
-// glsl/atlas_common.glsl stretch_half_width) and copies them into `texels` and `stretch` (size²
-// vec2, row-major). Returns the written buffers (nothing reads `stretch` in a radius blur: the
-// graph culls its copy).
+// coverage) and, when `stretch_target` is valid, into it (RG32F, cleared to -1: the
+// stretch-compensated blur's box half-widths along x and y for `variance`, from the covering
+// triangle's stretch; glsl/atlas_common.glsl stretch_half_width), and copies them into `texels`
+// and `stretch` (size² vec2, row-major). `pipeline` has two colour attachments then
+// (atlas_raster.frag), else one (atlas_raster_value.frag) and `stretch` is neither written nor
+// returned (a blur with one width in texels never reads it). Returns the written buffers.
 struct AtlasRasterPass {
   const vk::Pipeline* pipeline = nullptr;
   vk::ImageHandle target, stretch_target;

@@ -1,7 +1,9 @@
 // Atlas raster pass: the mapping's triangles, one value per corner, into an RG32F atlas
-// (value, coverage) cleared to zero and an RG32F target of the stretch-compensated blur's box
-// half-widths along x and y (from the triangle's model units per texel; cleared to -1: none)
-// (glsl/atlas_raster.*), then copied into the buffers the blur works on. Fragments outside their triangle's chart rectangle are discarded in the shader.
+// (value, coverage) cleared to zero and, when the blur is stretch-compensated, an RG32F target of
+// its box half-widths along x and y (from the triangle's model units per texel; cleared to -1:
+// none) (glsl/atlas_raster*), then copied into the buffers the blur works on. Without a stretch
+// target the pass has one colour attachment (the atlas_raster_value.frag pipeline). Fragments
+// outside their triangle's chart rectangle are discarded in the shader.
 #include "atlas_passes.hpp"
 
 namespace sdfkit::diffusion::passes {
@@ -11,8 +13,10 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
   auto raster = graph.add_pass("atlas.raster", vk::PassKind::Graphics);
   const VkClearColorValue zero{{0.0f, 0.0f, 0.0f, 0.0f}};
   const vk::ImageHandle target = raster.color(in.target, vk::LoadOp::Clear, zero);
+  const bool with_stretch = in.stretch_target.valid();
   const vk::ImageHandle stretch_target =
-      raster.color(in.stretch_target, vk::LoadOp::Clear, VkClearColorValue{{-1.0f, -1.0f, 0.0f, 0.0f}});
+      with_stretch ? raster.color(in.stretch_target, vk::LoadOp::Clear, VkClearColorValue{{-1.0f, -1.0f, 0.0f, 0.0f}})
+                   : vk::ImageHandle{};
   raster.vertex(in.vertices);
   raster.storage_read(in.charts);
   raster.execute([in](vk::PassContext& pc) {
@@ -43,7 +47,7 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
   };
   AtlasRasterOutput out;
   out.texels = copy_out("atlas.raster.copy", target, in.texels);
-  out.stretch = copy_out("atlas.raster.stretch_copy", stretch_target, in.stretch);
+  if (with_stretch) out.stretch = copy_out("atlas.raster.stretch_copy", stretch_target, in.stretch);
   return out;
 }
 

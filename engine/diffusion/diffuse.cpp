@@ -30,10 +30,12 @@ double ms_since(Clock::time_point t) {
 
 constexpr VkFormat kRasterFormat = VK_FORMAT_R32G32_SFLOAT;
 
-vk::Pipeline make_raster_pipeline(vk::Context& ctx) {
+// `with_stretch`: the second colour attachment, the stretch-compensated blur's half-widths
+// (atlas_raster.frag); else value and coverage alone (atlas_raster_value.frag).
+vk::Pipeline make_raster_pipeline(vk::Context& ctx, bool with_stretch) {
   vk::GraphicsPipelineDescription d;
   d.vertex_shader = "atlas_raster.vert";
-  d.fragment_shader = "atlas_raster.frag";
+  d.fragment_shader = with_stretch ? "atlas_raster.frag" : "atlas_raster_value.frag";
   d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
   d.push_bytes = sizeof(passes::RasterPush);
   d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, uv)},
@@ -41,7 +43,8 @@ vk::Pipeline make_raster_pipeline(vk::Context& ctx) {
                   {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)},
                   {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, stretch)}};
   d.vertex_stride = sizeof(passes::RasterVertex);
-  d.color_formats = {kRasterFormat, kRasterFormat};  // (value, coverage), stretch
+  d.color_formats = {kRasterFormat};  // (value, coverage)
+  if (with_stretch) d.color_formats.push_back(kRasterFormat);  // the half-widths
   d.depth_write = false;
   return vk::create_graphics_pipeline(ctx, d);
 }
@@ -239,7 +242,8 @@ int kring_for_sigma(float sigma, float mean_edge) {
 struct Diffuser::Impl {
   explicit Impl(vk::Context& c)
       : ctx(c),
-        raster(make_raster_pipeline(c)),
+        raster(make_raster_pipeline(c, false)),
+        raster_stretch(make_raster_pipeline(c, true)),
         blur(make_compute(c, "atlas_blur.comp", 4, sizeof(passes::BlurPush))),
         blur_box(make_compute(c, "atlas_blur_box.comp", 4, sizeof(passes::BlurPush))),
         blur_stretch(make_compute(c, "atlas_blur_stretch.comp", 6, sizeof(passes::StretchBlurPush))),
@@ -247,7 +251,7 @@ struct Diffuser::Impl {
         dilate(make_compute(c, "atlas_dilate.comp", 3, sizeof(passes::DilatePush))),
         transients(c) {}
   vk::Context& ctx;
-  vk::Pipeline raster, blur, blur_box, blur_stretch, sample, dilate;
+  vk::Pipeline raster, raster_stretch, blur, blur_box, blur_stretch, sample, dilate;
   vk::TransientPool transients;
 };
 
@@ -389,13 +393,18 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   const auto range_h = graph.import_buffer("atlas.ranges", range_buf.size, host_written(range_buf));
   const auto value_h = graph.import_buffer("atlas.values", value_buf.size, {value_buf.get()});
   const auto target = graph.create_image("atlas.raster", {kRasterFormat, size, size, 1});
-  const auto stretch_target = graph.create_image("atlas.raster.stretch", {kRasterFormat, size, size, 1});
-  const auto stretch = graph.create_buffer("atlas.stretch", VkDeviceSize{size} * size * sizeof(glm::vec2));
+  // The half-widths exist only for a stretch-compensated blur (a radius in texels, or no blur,
+  // never reads them).
+  const bool with_stretch = result.plan.stretch && options.blur;
+  const auto stretch_target =
+      with_stretch ? graph.create_image("atlas.raster.stretch", {kRasterFormat, size, size, 1}) : vk::ImageHandle{};
+  const auto stretch = with_stretch ? graph.create_buffer("atlas.stretch", VkDeviceSize{size} * size * sizeof(glm::vec2))
+                                    : vk::BufferHandle{};
   const auto texels = graph.create_buffer("atlas.texels", texel_bytes);
   const auto scratch = graph.create_buffer("atlas.scratch", texel_bytes);
 
   passes::AtlasRasterPass rp;
-  rp.pipeline = &impl_->raster;
+  rp.pipeline = with_stretch ? &impl_->raster_stretch : &impl_->raster;
   rp.target = target;
   rp.stretch_target = stretch_target;
   rp.vertices = soup_h;
@@ -412,7 +421,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   passes::AtlasBlurPass bp;
   bp.pipeline = &impl_->blur;
   bp.box_pipeline = &impl_->blur_box;
-  if (result.plan.stretch) {
+  if (with_stretch) {
     bp.stretch_pipeline = &impl_->blur_stretch;
     bp.stretch = rastered.stretch;
     bp.prefix = graph.create_buffer("atlas.prefix", 2 * texel_bytes);  // vec4 per texel: (hi, lo)
@@ -456,7 +465,10 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   const auto exec_start = Clock::now();
   vk::ExecuteOptions eo;
   eo.profile = options.profile;
-  const std::vector<vk::PassTiming> timings = vk::execute(ctx, graph.compile(), impl_->transients, eo);
+  const vk::CompiledGraph compiled = graph.compile();
+  for (std::size_t r = 0; r < compiled.resource_names.size(); ++r)
+    if (compiled.physical_of[r] != UINT32_MAX) result.graph_resources.push_back(compiled.resource_names[r]);
+  const std::vector<vk::PassTiming> timings = vk::execute(ctx, compiled, impl_->transients, eo);
   result.timings.execute = ms_since(exec_start);
   for (const vk::PassTiming& t : timings) {
     const std::string_view name = t.pass;

@@ -18,8 +18,10 @@
 #include "sdfkit/post/compare.hpp"
 #include "sdfkit/post/smooth.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <random>
+#include <string_view>
 
 namespace sdfkit::diffusion {
 namespace {
@@ -520,6 +522,41 @@ TEST_F(Diffuse, StretchCompensationUsesEachAxisOwnScale) {
   EXPECT_GT(std::abs(fx - s2), 0.1 * s2);
   EXPECT_GT(std::abs(fy - s2), 0.1 * s2);
   std::printf("sigma² %.3f: stretch-compensated variance along x %.4f, y %.4f; one width per chart %.4f, %.4f\n", s2, vx, vy, fx, fy);
+}
+
+// The raster pass writes the per-texel stretch (a second colour attachment, its copy, and the
+// blur's prefix sums) only for the stretch-compensated blur: a radius in texels, a sigma with the
+// compensation off and no blur at all declare none of it in the graph, while the same values
+// still come back (constant field) and the stretch-compensated run still declares it.
+TEST_F(Diffuse, OnlyTheStretchCompensatedBlurDeclaresTheStretchTarget) {
+  const test::CylinderGrid g;
+  const Mesh m = test::open_cylinder(g.r, g.h, g.segments, g.stacks);
+  const AtlasMapping a = test::cylinder_wrapping_mapping(m, g, 512);
+  const std::vector<float> u(m.vertex_count(), 1.5f);
+  const auto has = [](const DiffuseResult& r, std::string_view name) {
+    return std::find(r.graph_resources.begin(), r.graph_resources.end(), name) != r.graph_resources.end();
+  };
+  DiffuseOptions radius;
+  radius.radius_px = 4.0f;
+  DiffuseOptions per_chart = sigma_of(0.3f);
+  per_chart.stretch = false;
+  DiffuseOptions unblurred = sigma_of(0.3f);
+  unblurred.blur = false;
+  for (const DiffuseOptions& o : {radius, per_chart, unblurred}) {
+    const DiffuseResult r = diffuser_->run(m, a, u, o);
+    EXPECT_TRUE(has(r, "atlas.raster"));
+    EXPECT_TRUE(has(r, "atlas.texels"));
+    EXPECT_FALSE(has(r, "atlas.raster.stretch"));
+    EXPECT_FALSE(has(r, "atlas.stretch"));
+    EXPECT_FALSE(has(r, "atlas.prefix"));
+    for (float x : r.values) ASSERT_NEAR(x, 1.5f, 1e-5f);
+  }
+  const DiffuseResult s = diffuser_->run(m, a, u, sigma_of(0.3f));
+  EXPECT_TRUE(s.plan.stretch);
+  EXPECT_TRUE(has(s, "atlas.raster.stretch"));
+  EXPECT_TRUE(has(s, "atlas.stretch"));
+  EXPECT_TRUE(has(s, "atlas.prefix"));
+  for (float x : s.values) ASSERT_NEAR(x, 1.5f, 1e-5f);
 }
 
 // smooth_texture_space builds the mapping with the band the blur needs: kBandSigmas sigma with

@@ -79,6 +79,7 @@ TEST(PushConstants, AtlasStructsMatchTheirGlslBlocks) {
   using namespace diffusion::passes;
   expect_block("atlas_raster.vert", {{SDFKIT_OFF(RasterPush, scale)}, sizeof(RasterPush)});
   expect_block("atlas_raster.frag", {{SDFKIT_OFF(RasterPush, scale)}, sizeof(RasterPush)});
+  expect_block("atlas_raster_value.frag", {{SDFKIT_OFF(RasterPush, scale)}, sizeof(RasterPush)});
   for (const char* blur : {"atlas_blur.comp", "atlas_blur_box.comp"})
     expect_block(blur, {{SDFKIT_OFF(BlurPush, job_offset), SDFKIT_OFF(BlurPush, job_count), SDFKIT_OFF(BlurPush, size),
                          SDFKIT_OFF(BlurPush, axis), SDFKIT_OFF(BlurPush, box), SDFKIT_OFF(BlurPush, src_tiled)},

@@ -5,9 +5,10 @@
 //
 //   atlas_raster  the AtlasTriangles, per-corner values, into an RG32F atlas (value, coverage 1),
 //                 each fragment clipped to its chart's rectangle (a triangle across the seam of a
-//                 wrapping chart is drawn once per side); copied into a texel buffer. Beside it
-//                 each triangle's stretch (model units per texel along x and y, the columns of
-//                 its map's Jacobian) into a second RG32F target, copied into a stretch buffer
+//                 wrapping chart is drawn once per side); copied into a texel buffer. For the
+//                 stretch-compensated blur only, beside it each triangle's stretch (model units
+//                 per texel along x and y, the columns of its map's Jacobian) into a second
+//                 RG32F target, copied into a stretch buffer (a radius in texels: one target)
 //   atlas_blur    a separable Gaussian as a cascade of three box filters per axis (one compute
 //                 pass per axis), each box a running sum along a row or column of one chart: the work per
 //                 texel is the same at every radius. Rows of a wrapping chart wrap; outside its
@@ -129,6 +130,9 @@ struct DiffuseResult {
   std::vector<float> atlas;   // size × size, row y at [y * size], NaN where no chart reaches (keep_atlas)
   DiffuseTimings timings;
   BlurPlan plan;
+  // The names of the render graph's resources that its live passes use (imported and
+  // transient, as compiled), e.g. "atlas.raster.stretch" only for a stretch-compensated blur.
+  std::vector<std::string> graph_resources;
 };
 
 // Checks that `mapping` fits `mesh` (sizes, chart indices, rectangles inside the atlas and apart,
