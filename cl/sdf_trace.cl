@@ -249,36 +249,64 @@ inline float lane_max(float8 t) {
   return max(max(m4.x, m4.y), max(m4.z, m4.w));
 }
 
+// The 4-wide BVH the bundles walk (built on the host from the binary BVH, opencl_backend.cpp's
+// WideNode): a node is eight float4, the four children's boxes as min x, min y, min z, max x,
+// max y, max z (one float per child), then the children's words and count words as uint4. A
+// child is an inner node (count word 0, word = its wide node) or a leaf (count word LEAF_BIT |
+// n, word = first triangle record); an unused slot is a leaf without triangles. The root is
+// wide node 0. Four children per node: the loads of a node are two neighbouring cache lines
+// issued together, instead of two binary levels loaded one after the other (the traversal
+// waits on memory: the two hottest instructions of a perf profile of the binary traversal were
+// the first uses of a far child's box and of a leaf's first triangle).
+
 // A hint to the cache (clang's __builtin_prefetch, a prefetch instruction on CPUs; the host
-// defines SDFKIT_PREFETCH for CPU devices only) for what visiting the node (word, count) reads
-// first: an internal node's second child's box (its first child's is next to it), a leaf's
-// first triangle records. Loads of far nodes and of triangles took a third of the samples of a
-// profile (perf) of the traversal at 3.3M triangles.
-inline void sdfkit_prefetch_child(__global const float4* bvh, __global const float4* tris,
+// defines SDFKIT_PREFETCH for CPU devices only) for what visiting a pushed child reads first:
+// an inner node's two cache lines, a leaf's first triangle records.
+inline void sdfkit_prefetch_child(__global const float4* wide, __global const float4* tris,
                                   uint word, uint count) {
 #if defined(__clang__) && defined(SDFKIT_PREFETCH)
   if (count & LEAF_BIT) {
     __builtin_prefetch(tris + 3 * word);
     __builtin_prefetch(tris + 3 * word + 4);
   } else {
-    __builtin_prefetch(bvh + 2 * word);
+    __builtin_prefetch(wide + 8 * word);
+    __builtin_prefetch(wide + 8 * word + 4);
   }
 #endif
 }
 
-// Per ray of a bundle (origins per lane), the entry distance into a box or INFINITY.
-inline float8 bundle_entry(float4 lo, float4 hi, float8 ox, float8 oy, float8 oz,
-                           float8 ix, float8 iy, float8 iz, float8 best_t) {
-  const float8 ax = (lo.x - ox) * ix, bx = (hi.x - ox) * ix;
-  const float8 ay = (lo.y - oy) * iy, by = (hi.y - oy) * iy;
-  const float8 az = (lo.z - oz) * iz, bz = (hi.z - oz) * iz;
+// Per ray of a bundle (origins per lane), the entry distance into the box (lo, hi) or INFINITY.
+inline float8 bundle_entry(float lx, float ly, float lz, float hx, float hy, float hz,
+                           float8 ox, float8 oy, float8 oz, float8 ix, float8 iy, float8 iz,
+                           float8 best_t) {
+  const float8 ax = (lx - ox) * ix, bx = (hx - ox) * ix;
+  const float8 ay = (ly - oy) * iy, by = (hy - oy) * iy;
+  const float8 az = (lz - oz) * iz, bz = (hz - oz) * iz;
   const float8 tin = max(max(max(min(ax, bx), min(ay, by)), min(az, bz)), (float8)0.0f);
   const float8 tout = min(min(min(max(ax, bx), max(ay, by)), max(az, bz)), best_t);
   return select((float8)INFINITY, tin, tin <= tout);
 }
 
-// Closest hits of the bundle: per lane the hit record (0xffffffff = none) and distance.
-inline void closest_hits_bundle(__global const float4* bvh, __global const float4* tris,
+// Orders (ta, ia) and (tb, ib) so that ta <= tb (a comparator of a sorting network).
+#define SDFKIT_ORDER(ta, ia, tb, ib)             \
+  {                                              \
+    const bool swap = tb < ta;                   \
+    const float t_lo = swap ? tb : ta;           \
+    tb = swap ? ta : tb;                         \
+    ta = t_lo;                                   \
+    const uint i_lo = swap ? ib : ia;            \
+    ib = swap ? ia : ib;                         \
+    ia = i_lo;                                   \
+  }
+
+// Closest hits of the bundle: per lane the hit record (0xffffffff = none) and distance. At an
+// inner node all four children are tested; the entered ones (by any lane) are visited nearest
+// first (by their smallest entry distance), the others wait on the stack.
+// A wide node pushes at most three children and the binary tree is under 72 levels deep (bvh.hpp),
+// so the wide walk's stack never holds more than 3 * 71 + 1 entries.
+#define WIDE_STACK_SIZE 216
+
+inline void closest_hits_bundle(__global const float4* wide, __global const float4* tris,
                                 float8 ox, float8 oy, float8 oz, float8 dx, float8 dy,
                                 float8 dz, int8 active, uint8* f_out, float8* t_out) {
   const float tiny = 1e-20f;
@@ -287,19 +315,11 @@ inline void closest_hits_bundle(__global const float4* bvh, __global const float
   const float8 iz = 1.0f / select(dz, copysign((float8)tiny, dz), fabs(dz) < tiny);
   float8 best_t = select((float8)(-1.0f), (float8)INFINITY, active);
   uint8 best_f = (uint8)0xffffffffu;
-  *f_out = best_f;
-  *t_out = best_t;
-  uint stack_node[BVH_STACK_SIZE];
-  float stack_t[BVH_STACK_SIZE];
+  uint stack_word[WIDE_STACK_SIZE], stack_count[WIDE_STACK_SIZE];
+  float stack_t[WIDE_STACK_SIZE];
   int sp = 0;
-  uint node = 0;
-  {
-    const float8 root = bundle_entry(bvh[0], bvh[1], ox, oy, oz, ix, iy, iz, best_t);
-    if (!(pair_min(root, root).x < INFINITY)) return;
-  }
+  uint word = 0, count = 0;  // the root, an inner node
   for (;;) {
-    const uint word = as_uint(bvh[2 * node].w), count = as_uint(bvh[2 * node + 1].w);
-    bool descend = false;
     if (count & LEAF_BIT) {
       const uint end = word + (count & ~LEAF_BIT);
       for (uint k = word; k < end; ++k) {
@@ -320,29 +340,51 @@ inline void closest_hits_bundle(__global const float4* bvh, __global const float
         best_f = select(best_f, (uint8)k, as_uint8(hit));
       }
     } else {
-      const uint a = node + 1, b = word;
-      const float4 alo = bvh[2 * a], ahi = bvh[2 * a + 1], blo = bvh[2 * b], bhi = bvh[2 * b + 1];
-      // Start the loads the next steps will need: a child's second child (its first is next
-      // to it) or a leaf child's first triangle records.
-      sdfkit_prefetch_child(bvh, tris, as_uint(alo.w), as_uint(ahi.w));
-      sdfkit_prefetch_child(bvh, tris, as_uint(blo.w), as_uint(bhi.w));
-      const float8 ta = bundle_entry(alo, ahi, ox, oy, oz, ix, iy, iz, best_t);
-      const float8 tb = bundle_entry(blo, bhi, ox, oy, oz, ix, iy, iz, best_t);
-      const float2 m2 = pair_min(ta, tb);
-      const float a_min = m2.x, b_min = m2.y;
-      const bool hit_a = a_min < INFINITY, hit_b = b_min < INFINITY;
-      if (hit_a || hit_b) {
-        const bool a_first = a_min <= b_min;
-        if (hit_a && hit_b && sp < BVH_STACK_SIZE) {
-          stack_node[sp] = a_first ? b : a;
-          stack_t[sp] = a_first ? b_min : a_min;
-          ++sp;
+      __global const float4* node = wide + 8 * word;
+      const float4 lx = node[0], ly = node[1], lz = node[2], hx = node[3], hy = node[4],
+                   hz = node[5];
+      const uint4 words = as_uint4(node[6]), counts = as_uint4(node[7]);
+      const float8 e0 = bundle_entry(lx.x, ly.x, lz.x, hx.x, hy.x, hz.x, ox, oy, oz, ix, iy, iz, best_t);
+      const float8 e1 = bundle_entry(lx.y, ly.y, lz.y, hx.y, hy.y, hz.y, ox, oy, oz, ix, iy, iz, best_t);
+      const float8 e2 = bundle_entry(lx.z, ly.z, lz.z, hx.z, hy.z, hz.z, ox, oy, oz, ix, iy, iz, best_t);
+      const float8 e3 = bundle_entry(lx.w, ly.w, lz.w, hx.w, hy.w, hz.w, ox, oy, oz, ix, iy, iz, best_t);
+      const float2 m01 = pair_min(e0, e1), m23 = pair_min(e2, e3);
+      // Nearest entry per child (INFINITY: no lane enters it, or an unused slot).
+      float t0 = counts.x == LEAF_BIT ? INFINITY : m01.x, t1 = counts.y == LEAF_BIT ? INFINITY : m01.y;
+      float t2 = counts.z == LEAF_BIT ? INFINITY : m23.x, t3 = counts.w == LEAF_BIT ? INFINITY : m23.y;
+      uint i0 = 0, i1 = 1, i2 = 2, i3 = 3;
+      SDFKIT_ORDER(t0, i0, t1, i1);
+      SDFKIT_ORDER(t2, i2, t3, i3);
+      SDFKIT_ORDER(t0, i0, t2, i2);
+      SDFKIT_ORDER(t1, i1, t3, i3);
+      SDFKIT_ORDER(t1, i1, t2, i2);
+      if (t0 < INFINITY) {
+        const uint ws[4] = {words.x, words.y, words.z, words.w};
+        const uint cs[4] = {counts.x, counts.y, counts.z, counts.w};
+        // Farthest first, so the nearer ones are popped first.
+        if (t3 < INFINITY && sp < WIDE_STACK_SIZE) {
+          stack_word[sp] = ws[i3];
+          stack_count[sp] = cs[i3];
+          stack_t[sp++] = t3;
+          sdfkit_prefetch_child(wide, tris, ws[i3], cs[i3]);
         }
-        node = a_first ? a : b;
-        descend = true;
+        if (t2 < INFINITY && sp < WIDE_STACK_SIZE) {
+          stack_word[sp] = ws[i2];
+          stack_count[sp] = cs[i2];
+          stack_t[sp++] = t2;
+          sdfkit_prefetch_child(wide, tris, ws[i2], cs[i2]);
+        }
+        if (t1 < INFINITY && sp < WIDE_STACK_SIZE) {
+          stack_word[sp] = ws[i1];
+          stack_count[sp] = cs[i1];
+          stack_t[sp++] = t1;
+          sdfkit_prefetch_child(wide, tris, ws[i1], cs[i1]);
+        }
+        word = ws[i0];
+        count = cs[i0];
+        continue;
       }
     }
-    if (descend) continue;
     for (;;) {
       if (sp == 0) {
         *f_out = best_f;
@@ -352,18 +394,20 @@ inline void closest_hits_bundle(__global const float4* bvh, __global const float
       --sp;
       // A pending node is kept while some ray may still enter it before its closest hit.
       if (stack_t[sp] <= lane_max(best_t)) {
-        node = stack_node[sp];
+        word = stack_word[sp];
+        count = stack_count[sp];
         break;
       }
     }
   }
 }
+#undef SDFKIT_ORDER
 
 // One work item per (bundle, ray), ray-major: neighbouring work items trace the same cone
 // direction from neighbouring bundles, so they meet the same nodes and triangles while these
 // are in cache (bundle-major order gave neighbouring work items the other rays of one bundle,
 // whose hits lie all over the far side). Writes the keys of its lanes like trace_rays.
-__kernel void trace_bundles(__global const float4* bvh, __global const float4* tris,
+__kernel void trace_bundles(__global const float4* wide, __global const float4* tris,
                             __global const float4* points, __global const float4* normals,
                             __global const float4* table, int n_rays, uint n_points,
                             float origin_offset, int rule, __global ulong* keys) {
@@ -387,7 +431,7 @@ __kernel void trace_bundles(__global const float4* bvh, __global const float4* t
   }
   uint8 f8;
   float8 t8;
-  closest_hits_bundle(bvh, tris, vload8(0, oxs), vload8(0, oys), vload8(0, ozs),
+  closest_hits_bundle(wide, tris, vload8(0, oxs), vload8(0, oys), vload8(0, ozs),
                       vload8(0, dxs), vload8(0, dys), vload8(0, dzs), vload8(0, act), &f8,
                       &t8);
   uint fs[BUNDLE];
@@ -408,3 +452,4 @@ __kernel void trace_bundles(__global const float4* bvh, __global const float4* t
   }
 }
 #endif
+

@@ -159,6 +159,86 @@ std::vector<std::uint32_t> spatial_order(std::span<const glm::vec3> points) {
   return order;
 }
 
+
+// A node of the 4-wide BVH that trace_bundles walks (cl/sdf_trace.cl): the four children's
+// boxes, one float per child and coordinate, then per child its word and count word as in
+// BvhNode (a leaf: first triangle record and kLeafBit | n; an inner node: its wide node and 0).
+// Unused slots are leaves without triangles and empty boxes.
+struct WideNode {
+  float lo[3][4];
+  float hi[3][4];
+  std::uint32_t word[4];
+  std::uint32_t count[4];
+};
+static_assert(sizeof(WideNode) == 128);
+
+// Collapses the binary subtree under `node` into wide nodes appended to `out` (depth-first, a
+// node before its children) and returns its index: a wide node's children are the binary
+// node's children, the inner one with the largest surface replaced by its own two children
+// while fewer than four. The same leaves and boxes as the binary tree, so the same triangles
+// are tested for every ray that reaches them.
+std::uint32_t collapse_wide(const Bvh& bvh, std::uint32_t node, std::vector<WideNode>& out) {
+  const auto index = static_cast<std::uint32_t>(out.size());
+  out.emplace_back();
+  std::uint32_t kids[4];
+  int n = 0;
+  if (bvh.nodes[node].is_leaf()) {
+    kids[n++] = node;  // a root that is a leaf
+  } else {
+    kids[n++] = node + 1;
+    kids[n++] = bvh.nodes[node].first_or_second;
+  }
+  const auto area = [&](std::uint32_t k) {
+    const glm::vec3 e = bvh.nodes[k].max - bvh.nodes[k].min;
+    return e.x * e.y + e.y * e.z + e.z * e.x;
+  };
+  while (n < 4) {
+    int widest = -1;
+    float widest_area = -1.0f;
+    for (int i = 0; i < n; ++i)
+      if (!bvh.nodes[kids[i]].is_leaf() && area(kids[i]) > widest_area) {
+        widest = i;
+        widest_area = area(kids[i]);
+      }
+    if (widest < 0) break;
+    const std::uint32_t k = kids[widest];
+    kids[widest] = k + 1;
+    kids[n++] = bvh.nodes[k].first_or_second;
+  }
+  WideNode w;
+  for (int i = 0; i < 4; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      w.lo[a][i] = std::numeric_limits<float>::infinity();
+      w.hi[a][i] = -std::numeric_limits<float>::infinity();
+    }
+    w.word[i] = 0;
+    w.count[i] = BvhNode::kLeafBit;
+  }
+  for (int i = 0; i < n; ++i) {
+    const BvhNode& c = bvh.nodes[kids[i]];
+    for (int a = 0; a < 3; ++a) {
+      w.lo[a][i] = c.min[a];
+      w.hi[a][i] = c.max[a];
+    }
+    w.word[i] = c.is_leaf() ? c.first_or_second : 0;
+    w.count[i] = c.is_leaf() ? c.count : 0;
+  }
+  out[index] = w;
+  for (int i = 0; i < n; ++i)
+    if (!bvh.nodes[kids[i]].is_leaf()) {
+      const std::uint32_t child = collapse_wide(bvh, kids[i], out);
+      out[index].word[i] = child;
+    }
+  return index;
+}
+
+// Meshes whose binary BVH has at most this many nodes (16 MiB) keep it on the host beside the
+// device's wide copy, for update_positions' refit and bvh(); larger ones rebuild on
+// update_positions (the skeleton's contraction, the refit's user, runs on far smaller meshes)
+// and do not hold a second tree (13.3M triangles: 6M nodes, 194 MB). The same bound decides
+// whether update_positions leaves its upload running (it then keeps the records on the host too).
+constexpr std::size_t kKeepBinaryNodes = std::size_t{1} << 19;
+
 }  // namespace
 
 std::vector<DeviceInfo> list_devices() {
@@ -177,7 +257,7 @@ struct OpenClBackend::Impl {
   detail::Queue queue;
   detail::Program program;
   detail::Kernel k_trace, k_bundles, k_gather, k_dirs;
-  bool bundles = false;  // BVH traced by trace_bundles
+  bool bundles = false;  // BVH traced by trace_bundles, over the 4-wide copy (WideNode)
   std::size_t local_size = 0;  // work-group size of the trace and gather kernels (0 = driver's)
 
   // Geometry (resident between computes). The host keeps no positions (update_positions brings
@@ -187,9 +267,14 @@ struct OpenClBackend::Impl {
   std::size_t vertex_count = 0, face_count = 0;
   bool has_mesh = false;
   Octree octree;
-  Bvh bvh;  // nodes empty after set_mesh until the first refit (see read_back_nodes)
-  std::vector<glm::vec4> staging;  // the triangle records of a deferred upload (update_positions)
-  bool upload_pending = false;     // a deferred upload may still read `bvh.nodes` and `staging`
+  // Nodes empty between a build and the next refit (see read_back_nodes); with bundles, the
+  // device holds the wide copy and the host keeps these nodes for small meshes only.
+  Bvh bvh;
+  // A deferred upload (update_positions on a mesh whose tree the host keeps) reads these and
+  // `bvh.nodes` until the queue is drained: the wide nodes and the triangle records.
+  std::vector<WideNode> wide;
+  std::vector<glm::vec4> staging;
+  bool upload_pending = false;
   std::size_t bvh_node_count = 0;
   double built_sah = 0.0;  // sah_cost of the last full build
   bool refitted = false;   // the last geometry update refit the BVH instead of building it
@@ -317,9 +402,6 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
   // The host copies the last deferred upload reads (BVH nodes, `staging`) are rewritten below.
   if (upload_pending) finish("uploading the moved mesh");
   upload_pending = false;
-  // update_positions with a BVH (the skeleton's contraction: small meshes, one update per
-  // iteration) keeps the nodes and records on the host and does not wait for their upload.
-  const bool deferred = positions_moved && config.accel == Accel::Bvh;
   auto start = std::chrono::steady_clock::now();
   // The triangle list of the leaves, leaf by leaf (octree: a triangle once per leaf it touches).
   const std::vector<std::uint32_t>* order = nullptr;
@@ -344,20 +426,38 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
   }
   octree_ms = ms_since(start);
 
+  // update_positions on a mesh whose tree the host keeps (the skeleton's contraction: small
+  // meshes, one update per iteration) keeps the nodes and records on the host and does not wait
+  // for their upload; a larger mesh's update uploads and drops them as set_mesh does.
+  const bool deferred =
+      positions_moved && config.accel == Accel::Bvh && bvh.nodes.size() <= kKeepBinaryNodes;
   start = std::chrono::steady_clock::now();
   const auto bytes_of = [](const auto& v) { return v.size() * sizeof(v[0]); };
   const cl_context ctx = context.get();
   if (config.accel == Accel::Bvh) {
     // The BVH's nodes travel in `cells` (float4 pairs); `nodes` is a placeholder argument.
-    cells.reserve(ctx, bytes_of(bvh.nodes), CL_MEM_READ_ONLY, "BVH nodes");
     nodes.reserve(ctx, 16, CL_MEM_READ_ONLY, "unused octree nodes");
-    write(cells.get(), bytes_of(bvh.nodes), bvh.nodes.data(), "BVH nodes");
     bvh_node_count = bvh.nodes.size();
-    if (!deferred) {
-      // set_mesh: the device has the nodes; the host copy goes before the triangle records are
-      // mapped (read_back_nodes brings it back for a refit).
-      finish("uploading the BVH nodes");
-      bvh.nodes = std::vector<BvhNode>();
+    if (bundles) {
+      wide.clear();
+      wide.reserve(bvh.nodes.size() / 3 + 1);
+      collapse_wide(bvh, 0, wide);
+      cells.reserve(ctx, bytes_of(wide), CL_MEM_READ_ONLY, "BVH nodes");
+      write(cells.get(), bytes_of(wide), wide.data(), "BVH nodes");
+      if (!deferred) {
+        finish("uploading the BVH nodes");
+        wide = std::vector<WideNode>();
+        if (bvh.nodes.size() > kKeepBinaryNodes) bvh.nodes = std::vector<BvhNode>();
+      }
+    } else {
+      cells.reserve(ctx, bytes_of(bvh.nodes), CL_MEM_READ_ONLY, "BVH nodes");
+      write(cells.get(), bytes_of(bvh.nodes), bvh.nodes.data(), "BVH nodes");
+      if (!deferred) {
+        // The device has the nodes: the host copy goes before the triangle records are mapped
+        // (read_back_nodes brings it back for a refit).
+        finish("uploading the BVH nodes");
+        bvh.nodes = std::vector<BvhNode>();
+      }
     }
   } else {
     nodes.reserve(ctx, bytes_of(octree.nodes), CL_MEM_READ_ONLY, "octree nodes");
@@ -409,7 +509,8 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
 }
 
 void OpenClBackend::Impl::read_back_nodes() {
-  if (config.accel != Accel::Bvh || !bvh.nodes.empty() || bvh_node_count == 0) return;
+  // With bundles the device holds the wide copy: nothing to read back.
+  if (config.accel != Accel::Bvh || bundles || !bvh.nodes.empty() || bvh_node_count == 0) return;
   bvh.nodes.resize(bvh_node_count);
   check(clEnqueueReadBuffer(queue.get(), cells.get(), CL_TRUE, 0, bvh_node_count * sizeof(BvhNode),
                             bvh.nodes.data(), 0, nullptr, nullptr),

@@ -224,6 +224,47 @@ TEST(OpenClUpdate, RefitsSmallMovesAndRebuildsLargeOnes) {
   }
 }
 
+// Bundles trace a 4-wide copy of the BVH; the host keeps the binary tree only up to 2^19 nodes.
+// A larger mesh (an icosphere of 1.3M triangles) keeps none, so update_positions rebuilds
+// instead of refitting, and the values still equal a fresh set_mesh's (on a sample of points).
+TEST(OpenClUpdateLarge, RebuildsWithoutAHostTreeAndMatchesAFreshBuild) {
+  SDFKIT_REQUIRE_CL(backend);
+  const Mesh base = shapes::icosphere(1.0f, 8);
+  Mesh moved = base;
+  for (glm::vec3& p : moved.positions) p = p * 1.02f + glm::vec3(0.01f * p.z, 0, 0);
+  const auto sample = [](const Mesh& m) {
+    SdfQuery all = make_query(m, SdfDomain::Vertex);
+    auto points = std::make_shared<std::vector<glm::vec3>>();
+    SdfQuery q;
+    q.origin_offset = all.origin_offset;
+    for (std::size_t i = 0; i < all.size(); i += 4099) {
+      points->push_back(all.origins[i]);
+      q.normals.push_back(all.normals[i]);
+      q.valid.push_back(all.valid[i]);
+    }
+    q.origins = *points;
+    q.origin_storage = points;
+    return q;
+  };
+  backend.set_mesh(base);
+  EXPECT_TRUE(backend.bvh().nodes.empty());
+  backend.update_positions(moved.positions);
+  EXPECT_EQ(backend.last_timings().front().stage, "bvh_build");
+  const SdfQuery q = sample(moved);
+  ASSERT_GT(q.size(), 100u);
+  const RawSdf updated = backend.compute(q, {});
+  backend.set_mesh(moved);
+  const RawSdf fresh = backend.compute(q, {});
+  EXPECT_EQ(updated.values, fresh.values);
+  EXPECT_EQ(updated.kept_rays, fresh.kept_rays);
+  // Rays across a sphere of radius ~1.02: chords between 0 and the diameter, none missing.
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    EXPECT_GT(fresh.kept_rays[i], 0u) << i;
+    EXPECT_GT(fresh.values[i], 0.5f) << i;
+    EXPECT_LT(fresh.values[i], 2.1f) << i;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Tracer, OpenClUpdate, ::testing::Values(test::Tracer::BvhBundles, test::Tracer::BvhSingle, test::Tracer::Octree),
                          [](const auto& p) { return std::string(test::tracer_name(p.param)); });
 

@@ -67,6 +67,8 @@ struct OpenClConfig {
   // its SAH cost stays within this factor of the last full build's; past it, or when a triangle
   // that was degenerate at the build is not any more, it rebuilds. 0 = always rebuild. The
   // skeleton's contraction moves vertices every iteration: measured in engine/opencl/README.md.
+  // With bundles, meshes over 2^19 BVH nodes (about a million triangles) always rebuild: the
+  // host does not keep their binary tree beside the device's wide copy.
   double bvh_refit_limit = 1.25;
   // BVH: trace ray r of 8 neighbouring points (Morton order) together as one float8 bundle
   // per work item (SIMD on CPU devices: nearly parallel rays from nearby origins, every lane
@@ -103,7 +105,9 @@ public:
 
   const DeviceInfo& device() const;
   const Octree& octree() const;  // empty unless accel == Octree
-  // Empty unless accel == Bvh. The nodes live on the device only; this reads them back.
+  // Empty unless accel == Bvh. Single rays: the nodes live on the device only; this reads them
+  // back. Bundles: the device holds a 4-wide copy, and the nodes are kept on the host for meshes
+  // of up to 2^19 nodes (about a million triangles); larger meshes: nodes empty.
   const Bvh& bvh() const;
   // Points per batch the memory cap allows for `rays` rays per point.
   std::size_t batch_points(int rays) const;
