@@ -16,7 +16,20 @@
 
 #define LEAF_BIT 0x80000000u
 
-// Moller-Trumbore: updates (*best_t, *best_f) when record f is hit at 0 < t < *best_t.
+// Exact ties (a ray through an edge or vertex shared by triangles hit at the same t) go to the
+// lexicographically smallest outward normal, whatever order the tree visits them in: the result
+// of a ray is its distance and hit normal, so it does not depend on the tree's shape (a refit
+// tree and a fresh build agree) and equal normals tie harmlessly.
+inline bool sdfkit_normal_before(float3 a, float3 b) {
+  return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
+}
+
+inline float3 sdfkit_record_normal(__global const float4* tris, uint f) {
+  return (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
+}
+
+// Moller-Trumbore: updates (*best_t, *best_f) when record f is hit at 0 < t < *best_t, or at
+// t == *best_t with a normal before the best's (sdfkit_normal_before).
 inline void hit_triangle(__global const float4* tris, uint f, float3 o, float3 d,
                          float* best_t, uint* best_f) {
   const float3 v0 = tris[3 * f].xyz, e1 = tris[3 * f + 1].xyz, e2 = tris[3 * f + 2].xyz;
@@ -31,7 +44,9 @@ inline void hit_triangle(__global const float4* tris, uint f, float3 o, float3 d
   const float v = dot(d, qv) * inv_det;
   if (v < 0.0f || u + v > 1.0f) return;
   const float t = dot(e2, qv) * inv_det;
-  if (t > 0.0f && t < *best_t) {
+  if (t > 0.0f && (t < *best_t || (t == *best_t && *best_f != 0xffffffffu &&
+                                   sdfkit_normal_before(sdfkit_record_normal(tris, f),
+                                                        sdfkit_record_normal(tris, *best_f))))) {
     *best_t = t;
     *best_f = f;
   }
@@ -334,8 +349,24 @@ inline void closest_hits_bundle(__global const float4* wide, __global const floa
                      qz = tx * e1.y - ty * e1.x;
         const float8 v = (dx * qx + dy * qy + dz * qz) * inv_det;
         const float8 t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
-        const int8 hit = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
-                         (u + v <= 1.0f) & (t > 0.0f) & (t < best_t);
+        const int8 on = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
+                        (u + v <= 1.0f) & (t > 0.0f);
+        int8 hit = on & (t < best_t);
+        // Exact ties, rare: per lane, the smaller normal wins (sdfkit_normal_before).
+        const uint8 tie = as_uint8(on & (t == best_t) & (best_f != (uint8)0xffffffffu));
+        const uint4 tie4 = tie.lo | tie.hi;
+        const uint2 tie2 = tie4.lo | tie4.hi;
+        if (tie2.x | tie2.y) {
+          const float3 nk = (float3)(v0.w, e1.w, e2.w);
+          int hs[BUNDLE];
+          uint ties[BUNDLE], bfs[BUNDLE];
+          vstore8(hit, 0, hs);
+          vstore8(tie, 0, ties);
+          vstore8(best_f, 0, bfs);
+          for (int l = 0; l < BUNDLE; ++l)
+            if (ties[l] && sdfkit_normal_before(nk, sdfkit_record_normal(tris, bfs[l]))) hs[l] = -1;
+          hit = vload8(0, hs);
+        }
         best_t = select(best_t, t, hit);
         best_f = select(best_f, (uint8)k, as_uint8(hit));
       }
