@@ -519,10 +519,6 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
   // Points are traced in Morton order of their origins (neighbouring work items meet the same
   // nodes and triangles, which keeps them in cache); the results go back to query order.
   const std::vector<std::uint32_t> order = spatial_order(query.origins);
-  // The results after the order: its sort's 12 bytes per point of scratch are gone by then
-  // (8 per point of results beside them was the 13M-triangle run's peak).
-  raw.values.assign(n, 0.0f);
-  raw.kept_rays.assign(n, 0u);
   // One batch of points and normals at a time (not a second copy of the whole query): the
   // blocking writes wait for the previous batch's kernels, which read the same buffers.
   std::vector<glm::vec4> pts(batch), nrm(batch);
@@ -530,6 +526,10 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
   // of per-point arrays in Morton order).
   std::vector<float> values(batch);
   std::vector<std::uint32_t> kept(batch);
+  // The per-point results after the Morton order: its sort's 12 bytes per point of scratch are
+  // gone by then (8 per point of results beside them was the 13M-triangle run's peak).
+  raw.values.assign(n, 0.0f);
+  raw.kept_rays.assign(n, 0u);
   const cl_int rule = static_cast<cl_int>(options.false_hit);
   for (std::size_t first = 0; first < n; first += batch) {
     const std::size_t count = std::min(batch, n - first);
