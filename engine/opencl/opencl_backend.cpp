@@ -449,7 +449,8 @@ void OpenClBackend::set_shared_mesh(std::shared_ptr<const Mesh> mesh) {
 }
 
 // update_positions needs a set_mesh after this, so the host's triangle order of the BVH (4 bytes
-// per triangle, what a refit reads) goes too: the device's records keep the geometry.
+// per triangle, what a refit reads) goes too: the device's records keep the geometry, and bvh()
+// then has nodes but an empty order.
 void OpenClBackend::release_mesh() {
   impl_->shape.reset();
   impl_->bvh.order = std::vector<std::uint32_t>();

@@ -103,8 +103,7 @@ public:
 
   const DeviceInfo& device() const;
   const Octree& octree() const;  // empty unless accel == Octree
-  // Empty unless accel == Bvh. The nodes live on the device only; this reads them back. Its
-  // triangle order is empty after release_mesh (only a refit reads it).
+  // Empty unless accel == Bvh. The nodes live on the device only; this reads them back.
   const Bvh& bvh() const;
   // Points per batch the memory cap allows for `rays` rays per point.
   std::size_t batch_points(int rays) const;
