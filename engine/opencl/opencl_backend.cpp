@@ -107,11 +107,12 @@ constexpr std::size_t kCpuWorkGroup = 8;
 // Points per work item of trace_bundles (cl/sdf_trace.cl, given as SDFKIT_BUNDLE_WIDTH).
 constexpr std::size_t kBundle = 8;
 // Most points per batch on CPU devices, whose buffers are host memory beside the process's own:
-// 2^17 points at 30 rays are 35 MiB of batch buffers instead of the 512 MiB cap (2^18 held
-// another 35 MiB at the 13M-triangle run's peak), and a batch still traces for about a second
-// on a 2-core CPU at that size, so the launches cost nothing. A multiple of kBundle: the
-// bundles are the same as in one batch.
-constexpr std::size_t kCpuBatchPoints = std::size_t{1} << 17;
+// 2^16 points at 30 rays are 17.5 MiB of batch buffers instead of the 512 MiB cap (2^18 and
+// 2^17 held 35 and 17.5 MiB more at the 13M-triangle run's peak, which is the trace's), and a
+// batch still traces for about half a second on a 2-core CPU at that size, so the launches
+// (~100 batches there) cost nothing. A multiple of kBundle: the bundles are the same as in one
+// batch.
+constexpr std::size_t kCpuBatchPoints = std::size_t{1} << 16;
 
 std::size_t round_up(std::size_t n, std::size_t m) { return m == 0 ? n : (n + m - 1) / m * m; }
 
@@ -575,7 +576,13 @@ void OpenClBackend::set_shared_mesh(std::shared_ptr<const Mesh> mesh) {
   impl_->set_geometry(m, std::move(mesh));
 }
 
-void OpenClBackend::release_mesh() { impl_->shape.reset(); }
+// update_positions needs a set_mesh after this, so the host's triangle order of the BVH (4 bytes
+// per triangle, what a refit reads) goes too: the device's records keep the geometry, and bvh()
+// then has nodes but an empty order.
+void OpenClBackend::release_mesh() {
+  impl_->shape.reset();
+  impl_->bvh.order = std::vector<std::uint32_t>();
+}
 
 void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
   if (!impl_->has_mesh) throw Error("update_positions was called before set_mesh");
@@ -620,8 +627,6 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
     throw Error("the query's origins, normals and valid flags differ in length");
   const auto start = std::chrono::steady_clock::now();
   RawSdf raw;
-  raw.values.assign(n, 0.0f);
-  raw.kept_rays.assign(n, 0u);
   if (n == 0) {
     m.trace_ms = ms_since(start);
     return raw;
@@ -650,6 +655,10 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
   // of per-point arrays in Morton order).
   std::vector<float> values(batch);
   std::vector<std::uint32_t> kept(batch);
+  // The per-point results after the Morton order: its sort's 12 bytes per point of scratch are
+  // gone by then (8 per point of results beside them was the 13M-triangle run's peak).
+  raw.values.assign(n, 0.0f);
+  raw.kept_rays.assign(n, 0u);
   const cl_int rule = static_cast<cl_int>(options.false_hit);
   // The writes and the first read do not block: should a later call throw, the queue is drained
   // before the host arrays they use go away (declared after them, destroyed before them).

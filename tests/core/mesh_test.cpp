@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 using namespace sdfkit;
 
@@ -28,6 +30,53 @@ TEST(Normals, AngleWeightedVertexNormalIgnoresTriangulation) {
   const auto n = vertex_normals(m);
   for (std::size_t v = 0; v < m.positions.size(); ++v)
     EXPECT_NEAR(glm::dot(n[v], glm::normalize(m.positions[v])), 1.0f, 1e-5f) << v;
+}
+
+// vertex_normals keeps its sums in blocks of 2^21 vertices (freed as the output fills): on a
+// height field of 1449^2 vertices (two blocks) every normal is the one of a single array of
+// sums added in face order (written out here), bit for bit, and close to the surface's analytic
+// normal on both sides of the block border.
+TEST(Normals, VertexNormalsAcrossSumBlocksAreTheSequentialSums) {
+  constexpr std::uint32_t kSide = 1449;  // 2,099,601 vertices > 2^21
+  const auto height = [](float x, float y) { return 0.05f * std::sin(x) * std::cos(0.7f * y); };
+  Mesh m;
+  m.positions.reserve(std::size_t{kSide} * kSide);
+  const float step = 0.01f;
+  for (std::uint32_t j = 0; j < kSide; ++j)
+    for (std::uint32_t i = 0; i < kSide; ++i) {
+      const float x = step * static_cast<float>(i), y = step * static_cast<float>(j);
+      m.positions.push_back({x, y, height(x, y)});
+    }
+  for (std::uint32_t j = 0; j + 1 < kSide; ++j)
+    for (std::uint32_t i = 0; i + 1 < kSide; ++i) {
+      const std::uint32_t a = j * kSide + i, b = a + 1, c = a + kSide, d = c + 1;
+      m.triangles.push_back({a, b, d});
+      m.triangles.push_back({a, d, c});
+    }
+  ASSERT_GT(m.positions.size(), std::size_t{1} << 21);
+  const std::vector<glm::vec3> n = vertex_normals(m);
+  ASSERT_EQ(n.size(), m.positions.size());
+
+  std::vector<glm::dvec3> sum(m.positions.size(), glm::dvec3(0.0));
+  for (const Triangle& t : m.triangles) {
+    const glm::vec3 a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+    const glm::vec3 fn = glm::normalize(glm::cross(b - a, c - a));
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 p = m.positions[t[k]];
+      const glm::vec3 u = m.positions[t[(k + 1) % 3]] - p, v = m.positions[t[(k + 2) % 3]] - p;
+      const float angle = std::atan2(glm::length(glm::cross(u, v)), glm::dot(u, v));
+      sum[t[k]] += glm::dvec3(fn) * static_cast<double>(angle);
+    }
+  }
+  std::size_t differ = 0;
+  for (std::size_t v = 0; v < sum.size(); ++v) differ += n[v] != glm::vec3(sum[v] / glm::length(sum[v]));
+  EXPECT_EQ(differ, 0u);
+  for (const std::size_t v : {std::size_t{1} << 20, (std::size_t{1} << 21) - 1, std::size_t{1} << 21, sum.size() - kSide - 2}) {
+    const float x = m.positions[v].x, y = m.positions[v].y;
+    const glm::vec3 analytic = glm::normalize(glm::vec3(-0.05f * std::cos(x) * std::cos(0.7f * y),
+                                                        0.035f * std::sin(x) * std::sin(0.7f * y), 1.0f));
+    EXPECT_GT(glm::dot(n[v], analytic), 0.99999f) << v;
+  }
 }
 
 TEST(Normals, DegenerateFacesGiveNoNaN) {

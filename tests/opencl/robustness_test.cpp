@@ -425,5 +425,8 @@ TEST(OpenClRobustness, SharedMeshMatchesLentMeshAndCanBeReleased) {
   const RawSdf after = backend.compute(q, {});
   EXPECT_EQ(after.values, lent.values);
   EXPECT_THROW(backend.update_positions(base.positions), Error);
+  // What only a refit reads is gone with the mesh; the tree that traces is not.
+  EXPECT_TRUE(backend.bvh().order.empty());
+  EXPECT_EQ(backend.bvh().nodes.size(), lent_bvh.nodes.size());
   backend.set_mesh(base);  // leaves the shared backend as the other tests expect it
 }

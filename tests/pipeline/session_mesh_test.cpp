@@ -130,6 +130,9 @@ TEST(SessionMesh, RunComputeWritesWhatTheFullAssetWrites) {
       request.input = "builtin:" + shape;
       request.output = dir.path(shape + "-run." + ext);
       run_compute(request, session);
+      // The caller's session keeps what update_positions needs (only the one-shot run_compute,
+      // whose session goes with it, has its backend release the mesh).
+      EXPECT_TRUE(backend->held) << shape << "." << ext;
       request.output.clear();
       const ComputeResult full = compute_asset(request, [&]() -> Session& { return session; });
       ASSERT_FALSE(full.asset.input_positions.empty());
