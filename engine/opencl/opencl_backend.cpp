@@ -578,10 +578,15 @@ void OpenClBackend::set_shared_mesh(std::shared_ptr<const Mesh> mesh) {
 
 // update_positions needs a set_mesh after this, so the host's triangle order of the BVH (4 bytes
 // per triangle, what a refit reads) goes too: the device's records keep the geometry, and bvh()
-// then has nodes but an empty order.
+// then has nodes but an empty order. The wide nodes and records a deferred upload kept go too.
 void OpenClBackend::release_mesh() {
-  impl_->shape.reset();
-  impl_->bvh.order = std::vector<std::uint32_t>();
+  Impl& m = *impl_;
+  if (m.upload_pending) m.finish("uploading the moved mesh");
+  m.upload_pending = false;
+  m.wide = std::vector<WideNode>();
+  m.staging = std::vector<glm::vec4>();
+  m.shape.reset();
+  m.bvh.order = std::vector<std::uint32_t>();
 }
 
 void OpenClBackend::update_positions(std::span<const glm::vec3> positions) {
