@@ -165,9 +165,6 @@ struct Bins {
 struct Builder {
   BvhParams params;
   std::vector<Ref, Uninitialized<Ref>> refs;
-  // Splitting the top on the calling thread alone (build_all): partitions use all threads. The
-  // subtree tasks partition on their own thread (both cores are busy with tasks then).
-  bool in_top = false;
 
   // Bounds and centroid bounds of refs [begin, end).
   void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds) const {
@@ -254,103 +251,8 @@ struct Builder {
       cb[side].grow(centroid4(lo, hi));
     };
     s.children_measured = true;
-    if (in_top && end - begin >= kParallelBinning && std::thread::hardware_concurrency() > 1)
-      return partition_parallel(begin, end, s, left);
     const std::size_t mid = partition_taking(begin, end, left, take);
     for (int side = 0; side < 2; ++side) s.child_bounds[side] = bb[side].box(), s.child_cbounds[side] = cb[side].box();
-    return mid;
-  }
-  // partition_measured on all threads, the same element order as partition_taking: that loop
-  // swaps the j-th ref in [begin, mid) that goes right (counting up) with the j-th ref in
-  // [mid, end) that goes left (counting down). A pass counts each chunk's left refs and measures
-  // both sides; then each thread swaps the pairs of a run of chunks of [begin, mid), its first
-  // partner below mid found (before any swap) from the chunks' counts.
-  template <class Pred>
-  std::size_t partition_parallel(std::size_t begin, std::size_t end, Split& s, Pred left) {
-    constexpr std::size_t kChunk = std::size_t{1} << 14;
-    const std::size_t chunks = (end - begin + kChunk - 1) / kChunk;
-    const auto chunk_begin = [&](std::size_t c) { return begin + c * kChunk; };
-    const auto chunk_end = [&](std::size_t c) { return std::min(end, begin + (c + 1) * kChunk); };
-    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-    std::vector<std::size_t> lefts(chunks, 0);
-    struct Sides {
-      Box4 bb[2], cb[2];
-    };
-    std::vector<Sides> sides(threads + 1);
-    std::atomic<std::size_t> slot{0};
-    parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
-      Sides& out = sides[slot++];
-      for (std::size_t c = cb; c < ce; ++c) {
-        std::size_t count = 0;
-        for (std::size_t i = chunk_begin(c); i < chunk_end(c); ++i) {
-          const Ref& r = refs[i];
-          const int side = left(r) ? 0 : 1;
-          count += side == 0;
-          const __m128 lo = ref_lo(r), hi = ref_hi(r);
-          out.bb[side].grow(lo, hi);
-          out.cb[side].grow(centroid4(lo, hi));
-        }
-        lefts[c] = count;
-      }
-    }, 1, threads);
-    for (int side = 0; side < 2; ++side) {
-      Box4 bb, cb;
-      for (const Sides& p : sides) bb.grow(p.bb[side].lo, p.bb[side].hi), cb.grow(p.cb[side].lo, p.cb[side].hi);
-      s.child_bounds[side] = bb.box(), s.child_cbounds[side] = cb.box();
-    }
-    std::size_t mid = begin;
-    for (std::size_t c = 0; c < chunks; ++c) mid += lefts[c];
-    // Per chunk: refs going right below mid (front), refs going left from mid on (back).
-    std::vector<std::size_t> front(chunks, 0), back(chunks, 0);
-    for (std::size_t c = 0; c < chunks; ++c) {
-      const std::size_t b = chunk_begin(c), e = chunk_end(c);
-      if (e <= mid) {
-        front[c] = (e - b) - lefts[c];
-      } else if (b >= mid) {
-        back[c] = lefts[c];
-      } else {
-        std::size_t below = 0;
-        for (std::size_t i = b; i < mid; ++i) below += left(refs[i]) ? 1 : 0;
-        front[c] = (mid - b) - below;
-        back[c] = lefts[c] - below;
-      }
-    }
-    // Thread t swaps the front refs of chunks [first[t], first[t + 1]), starting at pair rank
-    // rank[t], whose back partner is at partner[t].
-    const std::size_t front_chunks = (mid - begin + kChunk - 1) / kChunk;
-    std::vector<std::size_t> first(threads + 1), partner(threads, end);
-    for (unsigned t = 0; t <= threads; ++t) first[t] = front_chunks * t / threads;
-    {
-      std::size_t rank = 0, c = 0, back_c = chunks, back_rank = 0;  // back chunks above back_c hold back_rank
-      for (unsigned t = 0; t < threads; ++t) {
-        for (; c < first[t]; ++c) rank += front[c];
-        // The chunk holding back rank `rank`, then the ref inside it.
-        while (back_c > 0 && back_rank + back[back_c - 1] <= rank) back_rank += back[--back_c];
-        if (back_c == 0) continue;  // no pairs left
-        const std::size_t bc = back_c - 1;
-        std::size_t skip = rank - back_rank;
-        for (std::size_t i = chunk_end(bc); i-- > std::max(chunk_begin(bc), mid);) {
-          if (!left(refs[i])) continue;
-          if (skip-- == 0) {
-            partner[t] = i;
-            break;
-          }
-        }
-      }
-    }
-    parallel_for(threads, [&](std::size_t tb, std::size_t te) {
-      for (std::size_t t = tb; t < te; ++t) {
-        if (first[t] == first[t + 1]) continue;
-        std::size_t b = partner[t];
-        const std::size_t f_end = std::min(mid, chunk_end(first[t + 1] - 1));
-        for (std::size_t f = chunk_begin(first[t]); f < f_end; ++f) {
-          if (left(refs[f])) continue;
-          while (!left(refs[b])) --b;
-          std::swap(refs[f], refs[b]);
-          --b;
-        }
-      }
-    }, 1, threads);
     return mid;
   }
   template <class Pred, class Take>
@@ -532,9 +434,7 @@ struct Builder {
                                                                       : n / (16 * threads);
     std::vector<Top> top;
     std::vector<int> tasks;
-    in_top = true;
     split_top(top, tasks, 0, n, 0, task_size, {});
-    in_top = false;
     std::vector<Subtree> parts(tasks.size());  // each freed once laid out below
     // Largest parts first.
     std::vector<std::size_t> schedule(tasks.size());
@@ -643,7 +543,7 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     throw InputError("the BVH leaf size must be at least 1, got " + std::to_string(params.leaf_size));
   if (!(params.traversal_cost > 0.0f) || !std::isfinite(params.traversal_cost))
     throw InputError("the BVH traversal cost must be positive, got " + std::to_string(params.traversal_cost));
-  Builder b{params, {}, false};
+  Builder b{params, {}};
   const auto degenerate = degenerate_faces(mesh);
   // Chunks of faces, each filling its own run of refs (after the kept faces of the chunks
   // before it): face order, on all threads, with no per-face slot table.

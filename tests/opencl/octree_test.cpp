@@ -199,14 +199,13 @@ TEST(Bvh, RefitBoxesContainTheMovedTriangles) {
 // positions (boxes recomputed bottom-up from the triangles, an independent computation) leaves
 // every node bit for bit as built. The build takes a node's bounds from its parent's partition
 // instead of measuring them again; this mesh (540k triangles) is large enough for the parallel
-// binning, the root's partition on all threads and the subtree tasks, and the leaf size is the
-// bundle tracer's.
+// binning and the subtree tasks, and the leaf size is the bundle tracer's.
 TEST(Bvh, BuildBoxesAreTheUnionsOfTheirTriangles) {
   const Mesh mesh = with_degenerate(shapes::torus(2.0f, 0.6f, 600, 450));
   ASSERT_GT(mesh.triangles.size(), std::size_t{1} << 19);
   for (const sdfkit::cl::BvhParams params : {sdfkit::cl::BvhParams{16, 3.0f}, sdfkit::cl::BvhParams{4, 1.0f}}) {
     const sdfkit::cl::Bvh built = sdfkit::cl::build_bvh(mesh, params);
-    expect_valid_bvh(built, mesh);  // the top's partitions run on all threads at this size
+    expect_valid_bvh(built, mesh);  // its parts laid out on all threads at this size
     sdfkit::cl::Bvh refit = built;
     ASSERT_TRUE(sdfkit::cl::refit_bvh(refit, mesh));
     ASSERT_EQ(refit.nodes.size(), built.nodes.size());
