@@ -464,39 +464,61 @@ struct Builder {
       for (std::thread& th : pool) th.join();
     }
 
+    // The layout: the top's nodes written here in depth-first order, each part's block placed
+    // where its subtree goes; the parts are then copied (their child indices shifted) on all
+    // threads.
     Bvh out;
-    std::size_t total = top.size();
+    std::size_t total = 0;
+    for (const Top& t : top) total += t.task < 0 ? 1 : 0;
     for (const Subtree& p : parts) total += p.nodes.size();
-    out.nodes.reserve(total);
+    out.nodes.resize(total);
+    std::vector<std::size_t> part_at(parts.size(), 0);
+    std::size_t at = 0;
     const auto emit = [&](auto&& self, int index) -> void {
       const Top& t = top[static_cast<std::size_t>(index)];
       out.depth = std::max(out.depth, t.depth);
       if (t.task >= 0) {
-        Subtree& p = parts[static_cast<std::size_t>(t.task)];
-        const auto offset = static_cast<std::uint32_t>(out.nodes.size());
-        for (BvhNode node : p.nodes) {
-          if (!node.is_leaf()) node.first_or_second += offset;
-          out.nodes.push_back(node);
-        }
+        const Subtree& p = parts[static_cast<std::size_t>(t.task)];
+        part_at[static_cast<std::size_t>(t.task)] = at;
+        at += p.nodes.size();
         out.depth = std::max(out.depth, p.depth);
         out.leaf_count += p.leaf_count;
-        p.nodes = std::vector<BvhNode>();  // one copy of the nodes at a time
         return;
       }
-      const std::size_t at = out.nodes.size();
-      out.nodes.emplace_back();
-      set_bounds(out.nodes[at], t.split.bounds);
+      const std::size_t here = at++;
+      set_bounds(out.nodes[here], t.split.bounds);
       if (t.split.leaf) {
-        out.nodes[at].first_or_second = static_cast<std::uint32_t>(t.begin);
-        out.nodes[at].count = BvhNode::kLeafBit | static_cast<std::uint32_t>(t.end - t.begin);
+        out.nodes[here].first_or_second = static_cast<std::uint32_t>(t.begin);
+        out.nodes[here].count = BvhNode::kLeafBit | static_cast<std::uint32_t>(t.end - t.begin);
         ++out.leaf_count;
         return;
       }
       self(self, t.child[0]);
-      out.nodes[at].first_or_second = static_cast<std::uint32_t>(out.nodes.size());
+      out.nodes[here].first_or_second = static_cast<std::uint32_t>(at);
       self(self, t.child[1]);
     };
     emit(emit, 0);
+    std::atomic<std::size_t> next_copy{0};
+    const auto copier = [&] {
+      for (std::size_t k; (k = next_copy++) < parts.size();) {
+        Subtree& p = parts[schedule[k]];
+        const auto offset = static_cast<std::uint32_t>(part_at[schedule[k]]);
+        BvhNode* dst = out.nodes.data() + offset;
+        for (std::size_t i = 0; i < p.nodes.size(); ++i) {
+          BvhNode node = p.nodes[i];
+          if (!node.is_leaf()) node.first_or_second += offset;
+          dst[i] = node;
+        }
+        p.nodes = std::vector<BvhNode>();
+      }
+    };
+    {
+      std::vector<std::thread> pool;
+      const std::size_t helpers = std::min<std::size_t>(threads, parts.size()) - (parts.empty() ? 0 : 1);
+      for (std::size_t k = 0; k < helpers; ++k) pool.emplace_back(copier);
+      copier();
+      for (std::thread& th : pool) th.join();
+    }
     out.order.resize(n);
     parallel_for(n, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) out.order[i] = refs[i].face;

@@ -12,6 +12,7 @@
 #include <glm/vec4.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -21,6 +22,7 @@
 #include <limits>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace sdfkit::cl {
 
@@ -173,16 +175,11 @@ struct WideNode {
 };
 static_assert(sizeof(WideNode) == 128);
 
-// Collapses the binary subtree under `node` into wide nodes appended to `out` (depth-first, a
-// node before its children) and returns its index: a wide node's children are the binary
-// node's children, the inner one with the largest surface replaced by its own two children
-// while fewer than four. The same leaves and boxes as the binary tree, so the same triangles
-// are tested for every ray that reaches them.
-std::uint32_t collapse_wide(const Bvh& bvh, std::uint32_t node, std::vector<WideNode>& out) {
-  const auto index = static_cast<std::uint32_t>(out.size());
-  out.emplace_back();
-  std::uint32_t kids[4];
-  int n = 0;
+// One wide node for the binary node `node`: its children are the binary node's children, the
+// inner one with the largest surface replaced by its own two children while fewer than four.
+// Fills `w` (an inner child's word left 0) and the `n` binary nodes it holds, slot by slot.
+void collapse_one(const Bvh& bvh, std::uint32_t node, WideNode& w, std::uint32_t (&kids)[4], int& n) {
+  n = 0;
   if (bvh.nodes[node].is_leaf()) {
     kids[n++] = node;  // a root that is a leaf
   } else {
@@ -206,7 +203,6 @@ std::uint32_t collapse_wide(const Bvh& bvh, std::uint32_t node, std::vector<Wide
     kids[widest] = k + 1;
     kids[n++] = bvh.nodes[k].first_or_second;
   }
-  WideNode w;
   for (int i = 0; i < 4; ++i) {
     for (int a = 0; a < 3; ++a) {
       w.lo[a][i] = std::numeric_limits<float>::infinity();
@@ -224,6 +220,19 @@ std::uint32_t collapse_wide(const Bvh& bvh, std::uint32_t node, std::vector<Wide
     w.word[i] = c.is_leaf() ? c.first_or_second : 0;
     w.count[i] = c.is_leaf() ? c.count : 0;
   }
+}
+
+// Collapses the binary subtree under `node` into wide nodes appended to `out` (depth-first, a
+// node before its children; indices relative to out's start) and returns its index. The same
+// leaves and boxes as the binary tree, so the same triangles are tested for every ray that
+// reaches them.
+std::uint32_t collapse_wide(const Bvh& bvh, std::uint32_t node, std::vector<WideNode>& out) {
+  const auto index = static_cast<std::uint32_t>(out.size());
+  out.emplace_back();
+  std::uint32_t kids[4];
+  int n = 0;
+  WideNode w;
+  collapse_one(bvh, node, w, kids, n);
   out[index] = w;
   for (int i = 0; i < n; ++i)
     if (!bvh.nodes[kids[i]].is_leaf()) {
@@ -232,6 +241,119 @@ std::uint32_t collapse_wide(const Bvh& bvh, std::uint32_t node, std::vector<Wide
     }
   return index;
 }
+
+// collapse_wide(bvh, 0, ...) of a large tree on all threads: the wide nodes near the root made
+// here, the binary subtrees below them of at most `grain` nodes collapsed as tasks into blocks
+// of their own, then placed where the depth-first layout puts them. Size it, then write it.
+class WideLayout {
+ public:
+  explicit WideLayout(const Bvh& bvh) : bvh_(bvh) {
+    // Small trees (below 2^16 nodes, ~1 ms) on the calling thread: a thread costs ~0.1 ms.
+    threads_ = bvh.nodes.size() < (std::size_t{1} << 16) ? 1u : std::max(1u, std::thread::hardware_concurrency());
+    const unsigned threads = threads_;
+    grain_ = std::max<std::size_t>(bvh.nodes.size() / (16 * threads), 1);
+    top_.reserve(64);
+    make_top(0);
+    std::atomic<std::size_t> next{0};
+    const auto worker = [&] {
+      for (std::size_t k; (k = next++) < tasks_.size();) {
+        Task& t = tasks_[k];
+        t.nodes.reserve(t.binary_nodes / 2 + 1);  // at most one wide node per inner binary node
+        collapse_wide(bvh_, t.node, t.nodes);
+      }
+    };
+    std::vector<std::thread> pool;
+    for (std::size_t k = 1; k < std::min<std::size_t>(threads, tasks_.size()); ++k) pool.emplace_back(worker);
+    worker();
+    for (std::thread& th : pool) th.join();
+    place(0);
+  }
+  std::size_t size() const { return size_; }
+  // Writes the size() wide nodes to `out`, the blocks on all threads; frees the blocks.
+  void write(WideNode* out) {
+    for (const Top& t : top_) out[t.at] = t.w;
+    std::atomic<std::size_t> next{0};
+    parallel_for(tasks_.size(), [&](std::size_t, std::size_t) {
+      for (std::size_t k; (k = next++) < tasks_.size();) {
+        Task& t = tasks_[k];
+        const auto offset = static_cast<std::uint32_t>(t.at);
+        WideNode* dst = out + t.at;
+        for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+          WideNode w = t.nodes[i];
+          for (int c = 0; c < 4; ++c)
+            if (w.count[c] == 0) w.word[c] += offset;  // an inner child: a wide node of the block
+          dst[i] = w;
+        }
+        t.nodes = std::vector<WideNode>();
+      }
+    }, 1, threads_);
+  }
+
+ private:
+  struct Top {
+    WideNode w;
+    int child[4] = {-1, -1, -1, -1};  // per slot: a Top (>= 0), a task (-2 - task) or none (-1)
+    std::size_t at = 0;
+  };
+  struct Task {
+    std::uint32_t node = 0;
+    std::size_t binary_nodes = 0;
+    std::vector<WideNode> nodes;
+    std::size_t at = 0;
+  };
+  // Nodes of the binary subtree under `node`: it ends after its rightmost leaf.
+  std::size_t binary_size(std::uint32_t node) const {
+    std::uint32_t k = node;
+    while (!bvh_.nodes[k].is_leaf()) k = bvh_.nodes[k].first_or_second;
+    return std::size_t{k} + 1 - node;
+  }
+  int make_top(std::uint32_t node) {
+    const int index = static_cast<int>(top_.size());
+    top_.emplace_back();
+    std::uint32_t kids[4];
+    int n = 0;
+    WideNode w;
+    collapse_one(bvh_, node, w, kids, n);
+    top_[static_cast<std::size_t>(index)].w = w;
+    for (int i = 0; i < n; ++i) {
+      if (bvh_.nodes[kids[i]].is_leaf()) continue;
+      const std::size_t size = binary_size(kids[i]);
+      int child = 0;
+      if (size > grain_) {
+        child = make_top(kids[i]);
+      } else {
+        child = -2 - static_cast<int>(tasks_.size());
+        tasks_.push_back(Task{kids[i], size, {}, 0});
+      }
+      top_[static_cast<std::size_t>(index)].child[i] = child;
+    }
+    return index;
+  }
+  // Depth-first positions, as collapse_wide appends them: a node, then each slot's subtree.
+  void place(int index) {
+    Top& t = top_[static_cast<std::size_t>(index)];
+    t.at = size_++;
+    for (int i = 0; i < 4; ++i) {
+      const int c = t.child[i];
+      if (c == -1) continue;
+      if (c >= 0) {
+        t.w.word[i] = static_cast<std::uint32_t>(size_);
+        place(c);
+      } else {
+        Task& task = tasks_[static_cast<std::size_t>(-2 - c)];
+        t.w.word[i] = static_cast<std::uint32_t>(size_);
+        task.at = size_;
+        size_ += task.nodes.size();
+      }
+    }
+  }
+  const Bvh& bvh_;
+  unsigned threads_ = 1;
+  std::size_t grain_ = 1;
+  std::vector<Top> top_;
+  std::vector<Task> tasks_;
+  std::size_t size_ = 0;
+};
 
 // Meshes whose binary BVH has at most this many nodes (16 MiB) keep it on the host beside the
 // device's wide copy, for update_positions' refit and bvh(); larger ones rebuild on
@@ -441,11 +563,24 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
     bvh_node_count = bvh.nodes.size();
     if (bundles) {
       wide.clear();
-      wide.reserve(bvh.nodes.size() / 3 + 1);
-      collapse_wide(bvh, 0, wide);
-      cells.reserve(ctx, bytes_of(wide), CL_MEM_READ_ONLY, "BVH nodes");
-      write(cells.get(), bytes_of(wide), wide.data(), "BVH nodes");
-      if (!deferred) {
+      if (deferred) {
+        wide.reserve(bvh.nodes.size() / 3 + 1);
+        collapse_wide(bvh, 0, wide);
+        cells.reserve(ctx, bytes_of(wide), CL_MEM_READ_ONLY, "BVH nodes");
+        write(cells.get(), bytes_of(wide), wide.data(), "BVH nodes");
+      } else {
+        // set_mesh: collapsed on all threads straight into the mapped device buffer (no host
+        // copy of the wide nodes beside it).
+        WideLayout layout(bvh);
+        const std::size_t bytes = layout.size() * sizeof(WideNode);
+        cells.reserve(ctx, bytes, CL_MEM_READ_ONLY, "BVH nodes");
+        cl_int err = CL_SUCCESS;
+        void* mapped = clEnqueueMapBuffer(queue.get(), cells.get(), CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0,
+                                          bytes, 0, nullptr, nullptr, &err);
+        check(err, "mapping the BVH node buffer");
+        layout.write(static_cast<WideNode*>(mapped));
+        check(clEnqueueUnmapMemObject(queue.get(), cells.get(), mapped, 0, nullptr, nullptr),
+              "unmapping the BVH node buffer");
         finish("uploading the BVH nodes");
         wide = std::vector<WideNode>();
         if (bvh.nodes.size() > kKeepBinaryNodes) bvh.nodes = std::vector<BvhNode>();

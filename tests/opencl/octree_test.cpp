@@ -205,6 +205,7 @@ TEST(Bvh, BuildBoxesAreTheUnionsOfTheirTriangles) {
   ASSERT_GT(mesh.triangles.size(), std::size_t{1} << 19);
   for (const sdfkit::cl::BvhParams params : {sdfkit::cl::BvhParams{16, 3.0f}, sdfkit::cl::BvhParams{4, 1.0f}}) {
     const sdfkit::cl::Bvh built = sdfkit::cl::build_bvh(mesh, params);
+    expect_valid_bvh(built, mesh);  // its parts laid out on all threads at this size
     sdfkit::cl::Bvh refit = built;
     ASSERT_TRUE(sdfkit::cl::refit_bvh(refit, mesh));
     ASSERT_EQ(refit.nodes.size(), built.nodes.size());
