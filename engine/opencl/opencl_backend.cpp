@@ -242,7 +242,7 @@ std::uint32_t collapse_wide(const Bvh& bvh, std::uint32_t node, std::vector<Wide
   return index;
 }
 
-// collapse_wide(bvh, 0, ...) of a large tree on all threads: the wide nodes near the root made
+// collapse_wide(bvh, 0, ...) on all threads (a small tree on the calling one): the wide nodes near the root made
 // here, the binary subtrees below them of at most `grain` nodes collapsed as tasks into blocks
 // of their own, then placed where the depth-first layout puts them. Size it, then write it.
 class WideLayout {
@@ -254,18 +254,15 @@ class WideLayout {
     grain_ = std::max<std::size_t>(bvh.nodes.size() / (16 * threads), 1);
     top_.reserve(64);
     make_top(0);
+    // Tasks differ in size: each thread takes the next one left.
     std::atomic<std::size_t> next{0};
-    const auto worker = [&] {
+    parallel_for(tasks_.size(), [&](std::size_t, std::size_t) {
       for (std::size_t k; (k = next++) < tasks_.size();) {
         Task& t = tasks_[k];
         t.nodes.reserve(t.binary_nodes / 2 + 1);  // at most one wide node per inner binary node
         collapse_wide(bvh_, t.node, t.nodes);
       }
-    };
-    std::vector<std::thread> pool;
-    for (std::size_t k = 1; k < std::min<std::size_t>(threads, tasks_.size()); ++k) pool.emplace_back(worker);
-    worker();
-    for (std::thread& th : pool) th.join();
+    }, 1, threads);
     place(0);
   }
   std::size_t size() const { return size_; }
@@ -427,6 +424,19 @@ struct OpenClBackend::Impl {
   void read_back_nodes();
   void ensure_table(int rays, float cone_degrees);
   void write(cl_mem buffer, std::size_t bytes, const void* data, const char* what);
+  // Fills the first `bytes` of `buffer` in place, `fill(mapped)` through a blocking map (no host
+  // copy beside the device's); nothing for 0 bytes.
+  template <class Fill>
+  void write_mapped(cl_mem buffer, std::size_t bytes, const char* what, Fill&& fill) {
+    if (bytes == 0) return;
+    cl_int err = CL_SUCCESS;
+    void* mapped = clEnqueueMapBuffer(queue.get(), buffer, CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0, bytes, 0,
+                                      nullptr, nullptr, &err);
+    check(err, std::string("mapping the ") + what + " buffer");
+    fill(mapped);
+    check(clEnqueueUnmapMemObject(queue.get(), buffer, mapped, 0, nullptr, nullptr),
+          std::string("unmapping the ") + what + " buffer");
+  }
   void run(cl_kernel kernel, std::size_t items, std::size_t local, const char* name);
   void finish(const char* what) { check(clFinish(queue.get()), what); }
 };
@@ -563,24 +573,18 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
     bvh_node_count = bvh.nodes.size();
     if (bundles) {
       wide.clear();
+      WideLayout layout(bvh);
+      const std::size_t bytes = layout.size() * sizeof(WideNode);
+      cells.reserve(ctx, bytes, CL_MEM_READ_ONLY, "BVH nodes");
       if (deferred) {
-        wide.reserve(bvh.nodes.size() / 3 + 1);
-        collapse_wide(bvh, 0, wide);
-        cells.reserve(ctx, bytes_of(wide), CL_MEM_READ_ONLY, "BVH nodes");
-        write(cells.get(), bytes_of(wide), wide.data(), "BVH nodes");
+        wide.resize(layout.size());
+        layout.write(wide.data());
+        write(cells.get(), bytes, wide.data(), "BVH nodes");
       } else {
-        // set_mesh: collapsed on all threads straight into the mapped device buffer (no host
-        // copy of the wide nodes beside it).
-        WideLayout layout(bvh);
-        const std::size_t bytes = layout.size() * sizeof(WideNode);
-        cells.reserve(ctx, bytes, CL_MEM_READ_ONLY, "BVH nodes");
-        cl_int err = CL_SUCCESS;
-        void* mapped = clEnqueueMapBuffer(queue.get(), cells.get(), CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0,
-                                          bytes, 0, nullptr, nullptr, &err);
-        check(err, "mapping the BVH node buffer");
-        layout.write(static_cast<WideNode*>(mapped));
-        check(clEnqueueUnmapMemObject(queue.get(), cells.get(), mapped, 0, nullptr, nullptr),
-              "unmapping the BVH node buffer");
+        // set_mesh: written straight into the mapped device buffer (no host copy of the wide
+        // nodes beside it).
+        write_mapped(cells.get(), bytes, "BVH node",
+                     [&](void* mapped) { layout.write(static_cast<WideNode*>(mapped)); });
         finish("uploading the BVH nodes");
         wide = std::vector<WideNode>();
         if (bvh.nodes.size() > kKeepBinaryNodes) bvh.nodes = std::vector<BvhNode>();
@@ -629,15 +633,8 @@ void OpenClBackend::Impl::rebuild_geometry(const Mesh& mesh, bool positions_move
     // set_mesh: written straight into the mapped device buffer (no host copy of 48 bytes per
     // triangle beside it).
     staging = std::vector<glm::vec4>();
-    if (record_bytes > 0) {
-      cl_int err = CL_SUCCESS;
-      void* mapped = clEnqueueMapBuffer(queue.get(), tris.get(), CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0,
-                                        record_bytes, 0, nullptr, nullptr, &err);
-      check(err, "mapping the triangle buffer");
-      fill_records(static_cast<glm::vec4*>(mapped));
-      check(clEnqueueUnmapMemObject(queue.get(), tris.get(), mapped, 0, nullptr, nullptr),
-            "unmapping the triangle buffer");
-    }
+    write_mapped(tris.get(), record_bytes, "triangle",
+                 [&](void* mapped) { fill_records(static_cast<glm::vec4*>(mapped)); });
     finish("uploading the mesh");
   }
   upload_ms = ms_since(start);
