@@ -498,8 +498,9 @@ struct Builder {
       self(self, t.child[1]);
     };
     emit(emit, 0);
+    // Parts differ in size: each thread takes the next one left.
     std::atomic<std::size_t> next_copy{0};
-    const auto copier = [&] {
+    parallel_for(parts.size(), [&](std::size_t, std::size_t) {
       for (std::size_t k; (k = next_copy++) < parts.size();) {
         Subtree& p = parts[schedule[k]];
         const auto offset = static_cast<std::uint32_t>(part_at[schedule[k]]);
@@ -511,14 +512,7 @@ struct Builder {
         }
         p.nodes = std::vector<BvhNode>();
       }
-    };
-    {
-      std::vector<std::thread> pool;
-      const std::size_t helpers = std::min<std::size_t>(threads, parts.size()) - (parts.empty() ? 0 : 1);
-      for (std::size_t k = 0; k < helpers; ++k) pool.emplace_back(copier);
-      copier();
-      for (std::thread& th : pool) th.join();
-    }
+    }, 1, threads);
     out.order.resize(n);
     parallel_for(n, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) out.order[i] = refs[i].face;
