@@ -3,7 +3,7 @@
 // same meshes, in the same run. Prints a Markdown table.
 //
 // usage: sdfkit_skeleton_bench [--backend opencl|embree] [--runs N] [MESH.off ...]
-//        sdfkit_skeleton_bench [--backend ...] --eval DIR [--filter TEXT] [--dump DIR]
+//        sdfkit_skeleton_bench [--backend ...] --eval DIR [--filter TEXT] [--dump DIR] [--cgal-from DIR]
 //                              [--max-vertices N] [--no-sdf-off] [--no-models]
 //   --eval     the evaluation (skeleton_eval.cpp): every closed mesh under DIR (CGAL's data set:
 //              the build tree's skeleton_eval_data) up to --max-vertices (100000) vertices plus
@@ -152,6 +152,8 @@ int main(int argc, char** argv) {
       eval.filter = argv[++i];
     } else if (arg == "--dump" && i + 1 < argc) {
       eval.dump = argv[++i];
+    } else if (arg == "--cgal-from" && i + 1 < argc) {
+      eval.cgal_dir = argv[++i];
     } else if (arg == "--max-vertices" && i + 1 < argc) {
       eval.max_vertices = std::strtoul(argv[++i], nullptr, 10);
     } else if (arg == "--no-sdf-off") {
@@ -165,7 +167,7 @@ int main(int argc, char** argv) {
     } else if (arg.rfind("--", 0) == 0) {
       std::fprintf(stderr, "usage: sdfkit_skeleton_bench [--backend opencl|embree] [--runs N] [MESH.off ...]\n"
                            "       sdfkit_skeleton_bench [--backend opencl|embree] --eval DIR [--filter TEXT] "
-                           "[--dump DIR] [--max-vertices N] [--no-sdf-off] [--no-models]\n");
+                           "[--dump DIR] [--cgal-from DIR] [--max-vertices N] [--no-sdf-off] [--no-models]\n");
       return 2;
     } else {
       paths.push_back(arg);

@@ -133,6 +133,45 @@ CgalResult run_cgal(const sdfkit::Mesh& mesh) {
   return r;
 }
 
+// CGAL's skeleton as an earlier run dumped it (write_graph_obj): points and edges; seconds < 0.
+CgalResult read_cgal(const std::string& path) {
+  CgalResult r;
+  std::ifstream in(path);
+  if (!in) {
+    r.error = "no " + path;
+    return r;
+  }
+  std::string tag;
+  while (in >> tag) {
+    if (tag == "v") {
+      glm::vec3 p;
+      in >> p.x >> p.y >> p.z;
+      r.graph.points.push_back(p);
+    } else if (tag == "l") {
+      std::uint32_t a = 0, b = 0;
+      in >> a >> b;
+      if (a < 1 || b < 1 || a > r.graph.points.size() || b > r.graph.points.size()) {
+        r.error = path + ": bad edge";
+        return r;
+      }
+      r.graph.edges.push_back({a - 1, b - 1});
+    }
+  }
+  std::vector<int> degree(r.graph.points.size(), 0);
+  for (const auto& e : r.graph.edges) ++degree[e[0]], ++degree[e[1]];
+  for (std::uint32_t v = 0; v < degree.size(); ++v)
+    if (degree[v] == 1) r.graph.leaves.push_back(v);
+  sdfkit::UnionFind uf(r.graph.points.size());
+  std::size_t components = r.graph.points.size();
+  for (const auto& e : r.graph.edges)
+    if (uf.unite(e[0], e[1])) --components;
+  r.cycles = static_cast<int>(r.graph.edges.size()) - static_cast<int>(r.graph.points.size()) +
+             static_cast<int>(components);
+  r.seconds = -1.0;
+  r.ok = true;
+  return r;
+}
+
 // Genus of a closed surface: per connected component (over shared vertices) (2 - chi) / 2.
 int genus(const sdfkit::Mesh& mesh, std::size_t& components) {
   const std::size_t n = mesh.positions.size();
@@ -257,6 +296,7 @@ Eval run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend, bool sdf_
     sk::SkeletonOptions so;  // library defaults; SDFKIT_EVAL_EXTEND_LEAVES=0 / SDFKIT_EVAL_PRUNE_BRANCHES=0 for the comparisons
     if (const char* v = std::getenv("SDFKIT_EVAL_EXTEND_LEAVES")) so.extend_leaves = std::atoi(v) != 0;
     if (const char* v = std::getenv("SDFKIT_EVAL_PRUNE_BRANCHES")) so.prune_branches = std::atoi(v) != 0;
+    if (const char* v = std::getenv("SDFKIT_EVAL_SECTION_NODES")) so.section_nodes = std::atoi(v) != 0;
     const sk::Skeleton s = sk::extract(mesh, &backend, co, so);
     const double seconds = seconds_since(t0);
     Eval e = measure(s, bvh);
@@ -315,7 +355,7 @@ struct Summary {
     sheet.push_back(e.nodes ? static_cast<double>(e.sheet_nodes) / e.nodes : 0.0);
     reliability.push_back(e.curve_reliability);
     if (c.ok) {
-      faster += e.seconds <= c.seconds;
+      faster += c.seconds >= 0.0 && e.seconds <= c.seconds;
       match.push_back(e.leaf_match);
       if (e.curve_distance >= 0.0) distance.push_back(e.curve_distance);
     }
@@ -417,7 +457,7 @@ int run_skeleton_eval(const SkeletonEvalArgs& args, sdfkit::SdfBackend& backend)
     Eval a = run_sdfkit(c.mesh, backend, true, bvh, dump.empty() ? "" : dump + ".sdfkit.obj");
     Eval b;
     if (args.no_sdf_run) b = run_sdfkit(c.mesh, backend, false, bvh, dump.empty() ? "" : dump + ".nosdf.obj");
-    const CgalResult cg = run_cgal(c.mesh);
+    const CgalResult cg = args.cgal_dir.empty() ? run_cgal(c.mesh) : read_cgal(args.cgal_dir + "/" + stem + ".cgal.obj");
     if (!dump.empty() && cg.ok) write_graph_obj(dump + ".cgal.obj", cg.graph);
     compare(a, cg, diag);
     compare(b, cg, diag);
@@ -437,7 +477,7 @@ int run_skeleton_eval(const SkeletonEvalArgs& args, sdfkit::SdfBackend& backend)
     }
     if (cg.ok) {
       char buf[256];
-      std::snprintf(buf, sizeof buf, "%.2f | %zu | %d | %s | %s", cg.seconds, cg.graph.leaves.size(), cg.cycles,
+      std::snprintf(buf, sizeof buf, "%s | %zu | %d | %s | %s", num(cg.seconds, "%.2f").c_str(), cg.graph.leaves.size(), cg.cycles,
                     pct(a.leaf_match).c_str(), num(a.curve_distance, "%.2f").c_str());
       theirs = buf;
     } else {

@@ -14,6 +14,10 @@ struct SkeletonEvalArgs {
   std::string filter;                 // comma-separated substrings: only meshes whose name contains one
   std::string dump;                   // when set: write both skeletons as OBJ files here
   bool no_sdf_run = true;             // also run with the SDF terms off
+  // When set: CGAL's skeleton of each mesh is read from DIR/<stem>.cgal.obj (an earlier run's
+  // --dump) instead of being computed, so two versions of ours are compared against the same
+  // CGAL skeleton (CGAL's MCF differs from run to run); CGAL's time is then not known ("–").
+  std::string cgal_dir;
   bool procedural = true;             // also evaluate the procedural models
 };
 

@@ -7,6 +7,7 @@
 // quantities over the whole data set (engine/skeleton/README.md).
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/mesh.hpp"
 #include "sdfkit/core/shapes.hpp"
 #include "sdfkit/core/weld.hpp"
 #include "sdfkit/core/topology.hpp"
@@ -22,7 +23,10 @@
 #include "bvh.hpp"       // engine/skeleton (private): the segment test the library and the eval use
 #include "validate.hpp"  // engine/skeleton (private): split_non_manifold
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -398,5 +402,96 @@ TEST(SkeletonRealMeshes, EveryCurveEdgeStaysInsideTheSolid) {
     }
     EXPECT_EQ(blocked, 0u) << name << ": curve edges cross the surface";
     EXPECT_EQ(outside, 0u) << name << ": curve edges leave the solid";
+  }
+}
+
+namespace {
+
+// Distance from p to the closest point of triangle (a, b, c) (Ericson, Real-Time Collision
+// Detection, 5.1.5).
+float point_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  const glm::vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.0f && d2 <= 0.0f) return glm::length(p - a);
+  const glm::vec3 bp = p - b;
+  const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.0f && d4 <= d3) return glm::length(p - b);
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+  const glm::vec3 cp = p - c;
+  const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.0f && d5 <= d6) return glm::length(p - c);
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f)
+    return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+  const float denom = 1.0f / (va + vb + vc);
+  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
+}
+
+// How central the curves are, measured on the surface alone: along every curve edge, every
+// 1 % of the bounding-box diagonal, the distance from the point to the surface divided by the
+// local radius interpolated between the edge's nodes (SDF/2). On the medial axis of a limb that
+// ratio is about 1; where an edge cuts across a bend as a chord it falls toward 0.
+struct Centrality {
+  double mean = 0.0;       // mean ratio
+  double near_wall = 0.0;  // share of points closer to the surface than half the local radius
+};
+
+Centrality centrality(const Mesh& mesh, const sk::Skeleton& s) {
+  const float step = 0.01f * bounding_box(mesh.positions).diagonal();
+  double sum = 0.0;
+  std::size_t count = 0, close = 0;
+  for (const auto& e : s.edges) {
+    const sk::Node &a = s.nodes[e[0]], &b = s.nodes[e[1]];
+    const int samples = std::max(1, static_cast<int>(std::ceil(glm::length(b.position - a.position) / step)));
+    for (int i = 0; i <= samples; ++i) {
+      const float t = static_cast<float>(i) / static_cast<float>(samples);
+      const glm::vec3 p = a.position + t * (b.position - a.position);
+      float d = std::numeric_limits<float>::max();
+      for (const Triangle& tri : mesh.triangles)
+        d = std::min(d, point_triangle(p, mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]));
+      const float r = (1.0f - t) * a.radius + t * b.radius;
+      if (!(r > 0.0f)) continue;
+      sum += d / r;
+      close += d < 0.5f * r;
+      ++count;
+    }
+  }
+  Centrality c;
+  if (count > 0) c.mean = sum / static_cast<double>(count), c.near_wall = static_cast<double>(close) / static_cast<double>(count);
+  return c;
+}
+
+}  // namespace
+
+// Curve edges run through the middle of the limbs, not as chords between grouped nodes
+// (SkeletonOptions::section_nodes, s11shape): measured against the surface only. Camel: a
+// quadruped whose legs and neck bend (man.off gives 0.687 against 0.594 and 0.229 against 0.352,
+// not run here: two more extractions of 17k vertices).
+TEST(SkeletonRealMeshes, CurvesRunThroughTheMiddleOfTheLimbs) {
+  {
+    const char* name = "camel.off";
+    SCOPED_TRACE(name);
+    const Mesh mesh = load(name);
+    reference::EmbreeBackend backend;
+    sk::SkeletonOptions chords;
+    chords.section_nodes = false;
+    const sk::Skeleton with = sk::extract(mesh, &backend, {}, {});
+    const sk::Skeleton without = sk::extract(mesh, &backend, {}, chords);
+    expect_valid(mesh, with, name);
+    EXPECT_EQ(sk::cycle_count(with), sk::cycle_count(without));
+    const auto leaves = [](const sk::Skeleton& s) {
+      const auto d = degrees(s);
+      return std::count(d.begin(), d.end(), 1);
+    };
+    EXPECT_EQ(leaves(with), leaves(without));  // sections only subdivide edges
+    const Centrality on = centrality(mesh, with), off = centrality(mesh, without);
+    std::printf("%s: distance to the surface / local radius along the curves: mean %.3f (chords %.3f), "
+                "under 0.5: %.3f (chords %.3f); nodes %zu (chords %zu)\n",
+                name, on.mean, off.mean, on.near_wall, off.near_wall, with.nodes.size(), without.nodes.size());
+    EXPECT_GT(on.mean, off.mean);
+    EXPECT_LT(on.near_wall, 0.8 * off.near_wall);  // measured: 0.125 against 0.329
   }
 }

@@ -156,6 +156,10 @@ struct SkeletonOptions {
   // the node it hangs from: it adds nothing to the solid the skeleton's balls describe (a bump
   // on the surface, not a limb); its vertices go to that node.
   bool prune_branches = true;
+  // Cut each curve edge longer than two local radii into cross-sections one local radius apart,
+  // with a node at the centre of each (the mean of its vertices' centre points), so the curve
+  // follows a bending limb instead of a chord between grouped nodes.
+  bool section_nodes = true;
 };
 
 struct Node {
