@@ -5,18 +5,21 @@ layout(location = 0) in vec2 in_uv;
 layout(location = 1) in float in_value;
 layout(location = 2) in uint in_chart;
 layout(location = 3) in vec2 in_stretch;  // model units per texel along x, y (the triangle's)
+layout(location = 4) in float in_variance;  // the blur's variance left over the triangle, model units²
 
 layout(push_constant) uniform Push {
-  vec4 scale;  // x: 2 / atlas size, y: the blur's variance (the fragment stage's)
+  vec4 scale;  // x: 2 / atlas size
 } pc;
 
 layout(location = 0) out float out_value;
 layout(location = 1) flat out uint out_chart;
 layout(location = 2) flat out vec2 out_stretch;
+layout(location = 3) flat out float out_variance;
 
 void main() {
   gl_Position = vec4(in_uv * pc.scale.x - 1.0, 0.0, 1.0);
   out_value = in_value;
   out_chart = in_chart;
   out_stretch = in_stretch;
+  out_variance = in_variance;
 }

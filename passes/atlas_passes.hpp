@@ -32,8 +32,13 @@ struct RasterVertex {
   float value;
   std::uint32_t chart; // fragments outside this chart's rectangle are discarded
   glm::vec2 stretch;   // the triangle's |dX/du|, |dX/dv|: model units per texel along the atlas's x and y
+  // The Gaussian's variance per axis left for the stretch-compensated blur over this triangle,
+  // model units²: sigma² less the variance the triangle's own linear interpolation adds
+  // (diffusion::triangle_interpolation_variance), so a mesh's fine and coarse parts each get
+  // what they lack of sigma². 0 for a blur of one width in texels (unused there).
+  float variance;
 };
-static_assert(sizeof(RasterVertex) == 24);
+static_assert(sizeof(RasterVertex) == 28);
 
 // One read of a vertex's value (atlas_sample.comp): AtlasMapping's VertexSample.
 struct SampleQuery {
@@ -51,7 +56,8 @@ struct SampleRange {
 static_assert(sizeof(SampleRange) == 16);
 
 struct RasterPush {  // atlas_raster.vert, atlas_raster.frag
-  glm::vec4 scale;   // x: 2 / atlas size, y: the stretch-compensated blur's variance (model units²)
+  glm::vec4 scale;   // x: 2 / atlas size, y: the stretch-compensated blur's variance where the mesh's triangles are
+                     // of its mean size (model units², for reference: the fragment stage reads RasterVertex::variance)
 };
 struct BlurPush {    // atlas_blur.comp, atlas_blur_box.comp
   std::uint32_t job_offset, job_count, size, axis, box, src_tiled;

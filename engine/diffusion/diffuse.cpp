@@ -41,7 +41,8 @@ vk::Pipeline make_raster_pipeline(vk::Context& ctx, bool with_stretch) {
   d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, uv)},
                   {1, 0, VK_FORMAT_R32_SFLOAT, offsetof(passes::RasterVertex, value)},
                   {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)},
-                  {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, stretch)}};
+                  {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, stretch)},
+                  {4, 0, VK_FORMAT_R32_SFLOAT, offsetof(passes::RasterVertex, variance)}};
   d.vertex_stride = sizeof(passes::RasterVertex);
   d.color_formats = {kRasterFormat};  // (value, coverage)
   if (with_stretch) d.color_formats.push_back(kRasterFormat);  // the half-widths
@@ -68,7 +69,7 @@ vk::Buffer make_buffer(vk::Context& ctx, std::size_t bytes, VkBufferUsageFlags u
 
 // The blur's sigma in a chart's texels. With sigma in model units, the variance the rest of the
 // road adds is taken off, so that the whole has the Gaussian's variance sigma² per axis: the
-// linear interpolation over the triangles (interpolation_variance, derived in diffuse.hpp) and
+// linear interpolation over the triangles (chart_interpolation_variance: the chart's own, derived in diffuse.hpp) and
 // the bilinear read-back at the vertex (weights 1 - f and f at distances f and 1 - f texels from
 // it: variance f (1 - f), 1/6 texel² over f uniform in [0, 1)). The rasterization point-samples the
 // interpolant at texel centres (no spread of its own) and the box cascade's variance is the
@@ -121,25 +122,51 @@ std::array<std::uint32_t, 3> box_radii(float sigma_px) {
   return r;
 }
 
+double triangle_interpolation_variance(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2) {
+  const glm::dvec3 a(p0), b(p1), c(p2);
+  return (glm::dot(b - a, b - a) + glm::dot(c - b, c - b) + glm::dot(a - c, a - c)) / 24.0;
+}
+
 double interpolation_variance(const Mesh& mesh) {
   double area = 0.0, sum = 0.0;
   for (const Triangle& t : mesh.triangles) {
     const glm::dvec3 a(mesh.positions[t[0]]), b(mesh.positions[t[1]]), c(mesh.positions[t[2]]);
     const double ar = 0.5 * glm::length(glm::cross(b - a, c - a));
-    const double e2 = glm::dot(b - a, b - a) + glm::dot(c - b, c - b) + glm::dot(a - c, a - c);
     area += ar;
-    sum += ar * e2 / 24.0;
+    sum += ar * triangle_interpolation_variance(mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]);
   }
   return area > 0.0 ? sum / area : 0.0;
 }
 
+std::vector<double> chart_interpolation_variance(const Mesh& mesh, const AtlasMapping& mapping) {
+  std::vector<double> area(mapping.charts.size(), 0.0), sum(mapping.charts.size(), 0.0);
+  for (const AtlasTriangle& t : mapping.triangles) {
+    if (t.chart >= mapping.charts.size() || t.face >= mesh.face_count()) continue;  // validate_mapping's to report
+    const Triangle& f = mesh.triangles[t.face];
+    const glm::dvec3 a(mesh.positions[f[0]]), b(mesh.positions[f[1]]), c(mesh.positions[f[2]]);
+    const double ar = 0.5 * glm::length(glm::cross(b - a, c - a));
+    area[t.chart] += ar;
+    sum[t.chart] += ar * triangle_interpolation_variance(mesh.positions[f[0]], mesh.positions[f[1]], mesh.positions[f[2]]);
+  }
+  const double whole = interpolation_variance(mesh);
+  for (std::size_t c = 0; c < sum.size(); ++c) sum[c] = area[c] > 0.0 ? sum[c] / area[c] : whole;
+  return sum;
+}
+
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, double interp_variance) {
+  return plan_blur(mapping, options, std::vector<double>(mapping.charts.size(), interp_variance));
+}
+
+BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, std::span<const double> chart_interp_variance) {
   check_options(options);
+  if (chart_interp_variance.size() != mapping.charts.size())
+    throw InputError("the blur's plan needs one interpolation variance per chart");
   BlurPlan plan;
   bool axis_fused[2] = {false, false}, axis_cascade[2] = {false, false};
   plan.stretch = options.sigma > 0.0f && options.stretch;
-  for (const Chart& c : mapping.charts) {
-    auto r = box_radii(sigma_px_of(c, options, interp_variance));
+  for (std::size_t ci = 0; ci < mapping.charts.size(); ++ci) {
+    const Chart& c = mapping.charts[ci];
+    auto r = box_radii(sigma_px_of(c, options, chart_interp_variance[ci]));
     // A periodic box no wider than the period (the shader wraps an index once at most).
     if (c.wraps_x)
       for (std::uint32_t& x : r) x = std::min(x, c.width > 1 ? (c.width - 1) / 2 : 0u);
@@ -279,7 +306,14 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
 
   DiffuseResult result;
   const double interp_variance = options.sigma > 0.0f ? interpolation_variance(mesh) : 0.0;
-  result.plan = plan_blur(mapping, options, interp_variance);
+  // The interpolation's variance is local (the kernel's mean of E(x) around the vertex read
+  // back): per chart for one width per chart, per triangle for the stretch-compensated blur.
+  // A mesh-wide mean would take a coarse part's large triangles' variance off a fine part's blur
+  // (a CAD part's long flat-face triangles: sqrt(mean) 1.1-1.6 mean edges on anchor, helmet,
+  // couplingdown, turbine, oblong, spool, so no blur at all there at sigma = 1 edge).
+  const std::vector<double> chart_interp =
+      options.sigma > 0.0f ? chart_interpolation_variance(mesh, mapping) : std::vector<double>(mapping.charts.size(), 0.0);
+  result.plan = plan_blur(mapping, options, std::span<const double>(chart_interp));
   // The stretch blur's prefix sums take two texel buffers' bytes (vec4 per texel).
   if (result.plan.stretch && ctx.capabilities().max_storage_buffer_range &&
       2 * texel_bytes > ctx.capabilities().max_storage_buffer_range)
@@ -308,9 +342,14 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     const auto& face = mesh.triangles[t.face];
     glm::vec2 uv[3] = {t.uv[0], t.uv[1], t.uv[2]};
     const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
+    // The stretch blur's variance over this triangle: sigma² less what its own interpolation adds.
+    const float tri_variance =
+        options.sigma > 0.0f
+            ? static_cast<float>(std::max(static_cast<double>(options.sigma) * options.sigma - triangle_interpolation_variance(x[0], x[1], x[2]), 0.0))
+            : 0.0f;
     if (!ch.wraps_x) {
       const glm::vec2 st = triangle_stretch(x, uv);
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], values[face[k]], t.chart, st});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], values[face[k]], t.chart, st, tri_variance});
       continue;
     }
     const float w = static_cast<float>(ch.width);
@@ -323,7 +362,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     for (int s = -2; s <= 2; ++s) {
       const float shift = static_cast<float>(s) * w;
       if (hi + shift <= static_cast<float>(ch.x0) || lo + shift >= static_cast<float>(ch.x0) + w) continue;
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), values[face[k]], t.chart, st});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), values[face[k]], t.chart, st, tri_variance});
     }
   }
   vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,

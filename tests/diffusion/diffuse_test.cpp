@@ -481,6 +481,69 @@ TEST_F(Diffuse, TheRoadAroundTheBlurAddsTheDerivedVariance) {
   }
 }
 
+// The interpolation's variance is taken off where it arises, not as the mesh's mean: the flat
+// grid of the test before (edges 1, E = 1/6) beside a coarse grid of edges 4 (E = 16/6, twice the
+// fine grid's area), each its own chart. The mesh's area-weighted mean E is 1.86, so taking it off
+// everywhere left the fine grid's blur 2.25 - 1.86 at sigma 1.5 (the whole road there measured
+// about 0.55 of the requested 2.25): what CAD parts with long flat-face triangles beside fine
+// fillets did (sdfkit-seam-bench, branch s13heat). With the triangle's own E (stretch blur) and the
+// chart's (one width per chart) the fine grid's road is sigma² again, as on the grid alone.
+TEST_F(Diffuse, InterpolationVarianceIsTakenOffWhereItArises) {
+  const int n = 34, nc = 13;
+  const float coarse = 4.0f, x_coarse = 100.0f, tpu = 1.37f;
+  Mesh m = unit_grid(n);
+  const Mesh c = unit_grid(nc);
+  const auto base = static_cast<std::uint32_t>(m.positions.size());
+  for (const glm::vec3& p : c.positions) m.positions.push_back({x_coarse + coarse * p.x, coarse * p.y, 0.0f});
+  for (const Triangle& t : c.triangles) m.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+  EXPECT_NEAR(interpolation_variance(m), (33.0 * 33.0 / 6.0 + 48.0 * 48.0 * 16.0 / 6.0) / (33.0 * 33.0 + 48.0 * 48.0), 1e-4);
+  AtlasMapping a;
+  a.size = 128;
+  a.gutter = 2;
+  const auto side = [&](float units) { return static_cast<std::uint32_t>(std::ceil(units * tpu)) + 1; };
+  a.charts.push_back({Chart::Kind::Joint, 2, 2, side(n - 1.0f), side(n - 1.0f), false, tpu});
+  a.charts.push_back({Chart::Kind::Joint, 60, 2, side(coarse * (nc - 1)), side(coarse * (nc - 1)), false, tpu});
+  const auto chart_of = [&](std::uint32_t v) { return v < base ? 0u : 1u; };
+  const auto uv = [&](std::uint32_t v) {
+    const glm::vec3 p = m.positions[v];
+    return v < base ? glm::vec2(2.5f + p.x * tpu, 2.5f + p.y * tpu) : glm::vec2(60.5f + (p.x - x_coarse) * tpu, 2.5f + p.y * tpu);
+  };
+  for (std::uint32_t f = 0; f < m.triangles.size(); ++f) {
+    const Triangle& t = m.triangles[f];
+    a.triangles.push_back({chart_of(t[0]), f, {uv(t[0]), uv(t[1]), uv(t[2])}});
+  }
+  for (std::uint32_t v = 0; v < m.positions.size(); ++v) {
+    a.vertex_chart.push_back(chart_of(v));
+    a.vertex_uv.push_back(uv(v));
+  }
+  const std::vector<double> per_chart_e = chart_interpolation_variance(m, a);
+  ASSERT_EQ(per_chart_e.size(), 2u);
+  EXPECT_NEAR(per_chart_e[0], 1.0 / 6.0, 1e-6);
+  EXPECT_NEAR(per_chart_e[1], 16.0 / 6.0, 1e-5);
+  const float cx = (n - 1) / 2.0f;
+  std::vector<float> u;
+  for (std::uint32_t v = 0; v < m.positions.size(); ++v) {
+    const glm::vec3 p = m.positions[v];
+    u.push_back(v < base ? (p.x - cx) * (p.x - cx) + (p.y - cx) * (p.y - cx) : 0.0f);
+  }
+  for (float sigma : {1.5f, 2.5f}) {
+    // interior_gain looks at the fine grid's interior only (the coarse grid lies at x >= 100).
+    const auto measure = [&](const DiffuseResult& r) { return interior_gain(m, n, 4.0f * sigma + 1.0f, r.values, u) / 2.0; };
+    const double stretched = measure(diffuser_->run(m, a, u, sigma_of(sigma)));
+    EXPECT_NEAR(stretched, sigma * sigma, 0.01 * sigma * sigma) << "sigma " << sigma;
+    DiffuseOptions one_width = sigma_of(sigma);
+    one_width.stretch = false;
+    const DiffuseResult r = diffuser_->run(m, a, u, one_width);
+    double boxes = 0.0;
+    for (std::uint32_t x : r.plan.radii[0]) boxes += ((2.0 * x + 1) * (2.0 * x + 1) - 1.0) / 12.0;
+    const double predicted = boxes / (tpu * tpu) + 1.0 / 6.0 + 1.0 / (6.0 * tpu * tpu);
+    EXPECT_NEAR(measure(r), predicted, 0.01 * predicted) << "sigma " << sigma;
+    EXPECT_GT(predicted, 0.85 * sigma * sigma) << "sigma " << sigma;  // the integer boxes' rounding only
+    std::printf("sigma %.1f: fine grid's variance per axis, stretch %.4f, one width per chart %.4f, requested %.4f\n",
+                static_cast<double>(sigma), stretched, measure(r), static_cast<double>(sigma * sigma));
+  }
+}
+
 // The stretch buffer's two axes: the same flat grid through a chart that scales x and y
 // differently (1.37 and 2.9 texels per unit, the chart's mean 2 between). A Gaussian blur of
 // u = x² adds the variance along x, of u = y² the variance along y; with the stretch

@@ -109,6 +109,9 @@ struct BlurPlan {
                                    // stretch-compensated six per box (prefix walk, half-width, two sums, two ends)
 };
 BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, double interpolation_variance = 0.0);
+// The same with one interpolation variance per chart (chart_interpolation_variance; what diffuse
+// uses): InputError unless there is one per chart.
+BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, std::span<const double> chart_interpolation_variance);
 
 // The variance per axis (model units²) that rasterizing a per-vertex field linearly over the
 // triangles adds to whatever kernel then reads it at the vertices. The field read back at vertex
@@ -120,6 +123,18 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, d
 // adds h² / 6, the textbook value). Per axis of the surface, area-weighted over the triangles:
 // mean (|e0|² + |e1|² + |e2|²) / 24. Tested with a quadratic field on a flat grid (diffuse_test).
 double interpolation_variance(const Mesh& mesh);
+// One triangle's share of it: E(x)'s mean over the triangle, the sum of its squared edges / 24 per
+// axis. The variance interpolation adds is local (the kernel's mean of E around the vertex read
+// back), so the diffusion takes it off where it arises, not as the mesh's mean: per atlas
+// triangle for the stretch-compensated blur (each triangle's texels blur with sigma² less its own
+// E), per chart (the area-weighted mean over the chart's atlas triangles) for one width per chart.
+// On a mesh of one triangle size the three are the same; on one with large and small triangles
+// (a CAD part: long flat-face triangles beside fine fillets) the mesh's mean can reach sigma² at
+// sigma = 1 mean edge and leave the fine parts unblurred.
+double triangle_interpolation_variance(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
+// Per chart of `mapping`: the area-weighted mean of triangle_interpolation_variance over its atlas
+// triangles (own and band); the mesh's for a chart without area.
+std::vector<double> chart_interpolation_variance(const Mesh& mesh, const AtlasMapping& mapping);
 
 // Three box radii (texels) whose cascade has variance sigma_px² (within the rounding of integer
 // boxes: Kovesi's mix of two odd widths). sigma_px <= 0 gives {0, 0, 0}.
