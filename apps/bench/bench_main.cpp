@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
       return emit(table, j);
     }
     if (diffusion) {
-      // Each blur cell is a difference of two graph runs' wall times: 7 pairs by default, so that
+      // Each blur cell is a difference of two graph runs' wall times: 5 pairs by default, so that
       // its median and quartiles stand against this shared VM's noise.
       if (app.count("--repeats") > 0) diffusion_options.repeats = std::max(o.repeats, 1);
       diffusion_options.device = o.device;
