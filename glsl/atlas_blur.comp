@@ -11,8 +11,8 @@
 // wrap instead, so nothing enters from another chart or the gutter. Both channels (value ·
 // coverage, coverage) are blurred (normalized convolution). The sums are the cascade's term for
 // term except on streamed wrapping rows, which start their walk r1 + r2 texels early and agree to
-// float rounding. plan_blur sends a long line here only when its radii fit the rings and the
-// walk's overrun past the line is small against it.
+// float rounding. plan_blur sends a long line here whenever its radii fit the rings (whatever
+// the walk's overrun past the line), so the blur's dispatches do not change with the radius.
 #extension GL_GOOGLE_include_directive : require
 #include "atlas_common.glsl"
 

@@ -31,6 +31,20 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The q-quantile of v (nearest rank): the spread of a cell is its quartiles.
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(std::lround(q * static_cast<double>(v.size() - 1)))];
+}
+
+// "p25–p75" of the runs, the spread beside a median.
+std::string spread(const std::vector<double>& v) {
+  char s[64];
+  std::snprintf(s, sizeof s, "%.0f–%.0f", quantile(v, 0.25), quantile(v, 0.75));
+  return s;
+}
+
 // A per-vertex field to diffuse: distance to the centroid (timings do not depend on the values).
 std::vector<float> bench_field(const Mesh& m) {
   glm::vec3 c(0.0f);
@@ -88,7 +102,8 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
   out["atlas_size"] = o.atlas_size;
   std::ostringstream md;
   md << "Texture-space diffusion (Table 2) on " << ctx.info().name << " (" << ctx.info().driver << "), atlas "
-     << o.atlas_size << "², median of " << o.repeats << " warm runs. prepare: host (triangle soup, jobs, queries "
+     << o.atlas_size << "², median of " << o.repeats << " warm runs "
+     << "(p25–p75: their quartiles; blur: the graphs with and without it alternate which runs first). prepare: host (triangle soup, jobs, queries "
      << "into upload memory); raster+sample: the graph without the blur passes (raster, copy, sample), wall time; "
      << "blur: the full graph's wall time minus that; read-back: values out of mapped memory; total: diffuse() "
      << "end to end (prepare + graph + read-back); blur, 6-dispatch cascade: the same blur as one dispatch per box "
@@ -101,8 +116,8 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
      << "the blur, which a loaded machine inflates far less than wall time. "
      << "lavapipe's timestamps around the blur's dispatches read ~0.1 ms (it records, then runs the whole "
      << "submission), so times here are wall-time differences.\n\n";
-  md << "| mesh | vertices | skeleton s | mapping ms | radius px | prepare ms | raster+sample ms | blur ms | read-back ms | total ms | blur, 6-dispatch cascade ms | blur CPU ms | cascade CPU ms | blur, stretch-compensated ms | stretch CPU ms |\n";
-  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  md << "| mesh | vertices | skeleton s | mapping ms | radius px | prepare ms | raster+sample ms | blur ms | blur p25–p75 | read-back ms | total ms | blur, 6-dispatch cascade ms | blur CPU ms | blur CPU p25–p75 | cascade CPU ms | blur, stretch-compensated ms | stretch CPU ms | blur dispatches |\n";
+  md << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   std::ostringstream kmd;
   kmd << "\nk-ring smoothing on the same meshes (engine/post/smooth, all cores):\n\n| mesh | vertices |";
   for (int k : o.rings) kmd << " k=" << k << " ms |";
@@ -163,20 +178,30 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
       if (with_stretch) diffuser.run(bm.mesh, mapping, u, st);  // warm-up
       for (int r = 0; r < o.repeats; ++r) {
         // CPU time of the whole process (lavapipe's worker threads included) beside the wall
-        // time: on a shared machine it is what the blur itself cost, whatever else runs.
-        std::clock_t c0 = std::clock();
-        unblurred.push_back(diffuser.run(bm.mesh, mapping, u, nb).timings.execute);
-        const std::clock_t c1 = std::clock();
-        const diffusion::DiffuseResult res = diffuser.run(bm.mesh, mapping, u, d);
-        const std::clock_t c2 = std::clock();
-        const double cpu_unblurred = cpu_ms(c0, c1);
-        cpu_blur.push_back(cpu_ms(c1, c2) - cpu_unblurred);
+        // time: on a shared machine it is what the blur itself cost, whatever else runs. The
+        // graphs with and without the blur alternate which runs first (a drift of the machine
+        // over the pair then cancels in the median of the differences).
+        double cpu_unblurred = 0.0, cpu_blurred = 0.0;
+        double unblurred_ms = 0.0;
+        diffusion::DiffuseResult res;
+        for (int k = 0; k < 2; ++k) {
+          const std::clock_t c0 = std::clock();
+          if ((k == 0) == (r % 2 == 0)) {
+            unblurred_ms = diffuser.run(bm.mesh, mapping, u, nb).timings.execute;
+            cpu_unblurred = cpu_ms(c0, std::clock());
+          } else {
+            res = diffuser.run(bm.mesh, mapping, u, d);
+            cpu_blurred = cpu_ms(c0, std::clock());
+          }
+        }
+        unblurred.push_back(unblurred_ms);
+        cpu_blur.push_back(cpu_blurred - cpu_unblurred);
         raster.push_back(unblurred.back());
         blur.push_back(res.timings.execute - unblurred.back());
         sample.push_back(res.timings.prepare);
         readback.push_back(res.timings.readback);
         total.push_back(res.timings.total);
-        c0 = std::clock();
+        std::clock_t c0 = std::clock();
         cascade.push_back(diffuser.run(bm.mesh, mapping, u, box).timings.execute - unblurred.back());
         cpu_cascade.push_back(cpu_ms(c0, std::clock()) - cpu_unblurred);
         if (with_stretch) {
@@ -194,6 +219,12 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
       jr["prepare_ms"] = median(sample);
       jr["raster_sample_ms"] = median(raster);
       jr["blur_ms"] = median(blur);
+      jr["blur_runs_ms"] = blur;
+      jr["blur_cpu_runs_ms"] = cpu_blur;
+      const diffusion::BlurPlan plan = diffusion::plan_blur(mapping, d);
+      jr["blur_fused_lines"] = plan.fused_lines;
+      jr["blur_cascade_lines"] = plan.cascade_lines;
+      jr["blur_texel_reads"] = plan.texel_reads;
       jr["blur_cascade_ms"] = median(cascade);
       jr["blur_cpu_ms"] = median(cpu_blur);
       jr["blur_cascade_cpu_ms"] = median(cpu_cascade);
@@ -202,15 +233,16 @@ nlohmann::json run_diffusion_bench(const std::vector<DiffusionMesh>& meshes, con
         jr["blur_stretch_ms"] = median(stretch);
         jr["blur_stretch_cpu_ms"] = median(cpu_stretch);
       }
-      jr["blur_dispatches"] = diffusion::plan_blur(mapping, d).dispatches;
+      jr["blur_dispatches"] = plan.dispatches;
       jr["readback_ms"] = median(readback);
       jr["total_ms"] = median(total);
       jm["radii"].push_back(jr);
-      char line[600];
-      std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.0f | %.0f | %.1f | %.0f |\n",
+      char line[700];
+      std::snprintf(line, sizeof line, "| %s | %zu | %.1f | %.0f | %.0f | %.1f | %.1f | %.1f | %s | %.1f | %.1f | %.1f | %.0f | %s | %.0f | %.1f | %.0f | %u |\n",
                     bm.name.c_str(), bm.mesh.vertex_count(), skeleton_s, mapping_ms, static_cast<double>(radius),
-                    median(sample), median(raster), median(blur), median(readback), median(total), median(cascade),
-                    median(cpu_blur), median(cpu_cascade), median(stretch), median(cpu_stretch));
+                    median(sample), median(raster), median(blur), spread(blur).c_str(), median(readback), median(total),
+                    median(cascade), median(cpu_blur), spread(cpu_blur).c_str(), median(cpu_cascade), median(stretch),
+                    median(cpu_stretch), plan.dispatches);
       md << line;
     }
     kmd << "| " << bm.name << " | " << bm.mesh.vertex_count() << " |";

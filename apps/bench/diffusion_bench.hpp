@@ -32,7 +32,7 @@ struct DiffusionBenchOptions {
   std::uint32_t atlas_size = 2048;
   std::vector<float> radii = {2, 4, 8, 16, 32, 64};
   std::vector<int> rings = {1, 2, 3, 4, 5, 6};
-  int repeats = 3;          // warm runs per radius; the median is reported
+  int repeats = 5;          // warm runs per radius; the median and quartiles are reported
   std::string device;       // Vulkan device selector
 };
 

@@ -178,10 +178,13 @@ BlurPlan plan_blur(const AtlasMapping& mapping, const DiffuseOptions& options, s
       const bool wrap = axis == 0 && c.wraps_x;
       const std::uint64_t e[3] = {r[0], r[1], r[2]};
       const std::uint64_t overrun = wrap ? 2 * (e[0] + e[1] + e[2]) : e[1] + e[2];
-      // A short line runs whole in private memory (any radius); a longer one streams.
+      // A short line runs whole in private memory (any radius); a longer one streams whenever
+      // its radii fit the rings, however long its overrun against the line: the same dispatches
+      // at every radius up to kFusedMaxRadius (a wrapping row's overrun read once still costs
+      // less than the cascade's three boxes, which read the whole line twice each).
       const bool whole = n <= passes::kShortLine;
       fused[static_cast<std::size_t>(axis)] =
-          options.fused_blur && !plan.stretch && (whole || (std::max({e[0], e[1], e[2]}) <= passes::kFusedMaxRadius && 2 * overrun <= n));
+          options.fused_blur && !plan.stretch && (whole || std::max({e[0], e[1], e[2]}) <= passes::kFusedMaxRadius);
       if (fused[static_cast<std::size_t>(axis)]) {
         // Every texel read once (a streamed line: what leaves box 0's window comes from a ring); a
         // streamed wrapping row also reads its overrun (a plain line reads nothing outside itself).

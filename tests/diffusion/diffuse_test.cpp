@@ -97,7 +97,7 @@ TEST(DiffusePlan, BoxCascadeHasTheGaussiansVariance) {
 // The blur's work (reads, dispatches) on a 2048² atlas: radius 64 costs what radius 2 costs (the
 // running sums read each texel once (fused) or twice per box (cascade) whatever the radius; only
 // the windows' warm-up and the fused walk's overrun grow), both fused in two dispatches. Radii
-// beyond the fused shader's rings, and lines short against their radii, take the cascade.
+// beyond the fused shader's rings take the cascade; lines short against their radii do not.
 TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   AtlasMapping a;
   a.size = 2048;
@@ -116,6 +116,17 @@ TEST(DiffusePlan, RadiusSixtyFourCostsWhatRadiusTwoCosts) {
   EXPECT_GE(p64.radii[0][0], 30u);
   EXPECT_EQ(p200.fused_lines, 0u);
   EXPECT_EQ(p200.dispatches, 6u);
+  // A wrapping chart of 300-texel rows, streamed, whose walk at radius 64 overruns its rows by
+  // more than half (2 (r0 + r1 + r2) > 150): still the same two fused dispatches as at radius 2.
+  AtlasMapping narrow;
+  narrow.size = 2048;
+  narrow.charts.push_back({Chart::Kind::Bone, 2, 2, 300, 1000, true, 10.0f});
+  const BlurPlan n2 = plan_blur(narrow, r2), n64 = plan_blur(narrow, r64);
+  EXPECT_GT(2 * (n64.radii[0][0] + n64.radii[0][1] + n64.radii[0][2]), 150u);
+  EXPECT_EQ(n2.dispatches, 2u);
+  EXPECT_EQ(n64.dispatches, 2u);
+  EXPECT_EQ(n64.fused_lines, 1300u);
+  EXPECT_EQ(n64.cascade_lines, 0u);
   // A small chart beside the big one at radius 200: the big chart's lines are too long for
   // private memory and the radius too large for the rings, so they take the cascade; the small
   // chart's lines run whole in private memory: per axis one fused and three cascade dispatches.
@@ -321,10 +332,12 @@ TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
     for (glm::vec2& uv : t.uv) uv.x += 530.0f;
     both.triangles.push_back(t);
   }
-  // Radius 12: every line fused, both ways; radius 48: the wrapping chart's rows overrun too far
-  // and take the cascade while the split charts' rows are fused, in the same axis.
+  // Radius 12: every line fused, both ways; radius 48: the wrapping chart's rows overrun them by
+  // more than half, still fused; radius 140: beyond the rings, the wrapping chart's lines take
+  // the cascade while the split charts' lines are fused, in the same axes.
   const std::vector<Case> cases = {{both, 12.0f},
                                    {both, 48.0f},
+                                   {both, 140.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 1.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 8.0f},
                                    {test::cylinder_wrapping_mapping(m, g, 512), 40.0f},
@@ -338,9 +351,9 @@ TEST_F(Diffuse, FusedBlurMatchesTheBoxCascade) {
     box.fused_blur = false;
     const DiffuseResult f = diffuser_->run(m, c.a, u, fused), b = diffuser_->run(m, c.a, u, box);
     EXPECT_GT(f.plan.fused_lines, 0u) << c.radius;
-    EXPECT_EQ(f.plan.cascade_lines > 0, c.radius == 48.0f) << c.radius;
-    if (c.radius == 48.0f) {
-      EXPECT_EQ(f.plan.fused[0], (std::array<bool, 2>{false, true}));
+    EXPECT_EQ(f.plan.cascade_lines > 0, c.radius == 140.0f) << c.radius;
+    if (c.radius == 140.0f) {
+      EXPECT_EQ(f.plan.fused[0], (std::array<bool, 2>{false, false}));
       EXPECT_EQ(f.plan.fused[1], (std::array<bool, 2>{true, true}));
     }
     EXPECT_EQ(b.plan.fused_lines, 0u);

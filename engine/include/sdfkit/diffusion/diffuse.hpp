@@ -94,9 +94,9 @@ struct BlurPlan {
   // Per chart, rows then columns: blurred by the fused shader (the three boxes of an axis in one
   // dispatch) rather than the cascade (one dispatch per box). Fused: lines up to
   // passes::kShortLine texels (whole in private memory, any radius), and longer lines whose radii
-  // fit the rings (kFusedMaxRadius) and whose walk's overrun past the line (r1 + r2, a wrapping
-  // row 2 (r0 + r1 + r2)) is at most half the line, since a streamed step costs about two cascade
-  // steps. Never with DiffuseOptions::fused_blur off.
+  // fit the rings (kFusedMaxRadius), whatever their walk's overrun past the line (r1 + r2, a
+  // wrapping row 2 (r0 + r1 + r2)), so that the passes do not change with the radius below
+  // that. Never with DiffuseOptions::fused_blur off.
   std::vector<std::array<bool, 2>> fused;
   // Stretch-compensated (DiffuseOptions::stretch with sigma): every line in the cascade, each
   // box's width per texel from the map's local stretch; radii are then the chart-scale widths,
