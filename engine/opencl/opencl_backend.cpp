@@ -110,7 +110,7 @@ constexpr std::size_t kCpuWorkGroup = 8;
 constexpr std::size_t kBundle = 8;
 // Bundles a trace_bundles work item walks on CPU devices, their steps alternated so that one
 // bundle's next node loads while the others' are tested (cl/sdf_trace.cl). Level 3 of the huge
-// bench, user CPU of the whole process: 4 bundles -11 %, 2 bundles -6 % (bench/RESULTS.md).
+// bench, user CPU of the whole process: 4 bundles -11 %, 2 bundles -5 % (bench/RESULTS.md).
 constexpr std::size_t kCpuBundlesPerItem = 4;
 // Most points per batch on CPU devices, whose buffers are host memory beside the process's own:
 // 2^16 points at 30 rays are 17.5 MiB of batch buffers instead of the 512 MiB cap (2^18 and
