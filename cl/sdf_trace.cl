@@ -314,140 +314,165 @@ inline float8 bundle_entry(float lx, float ly, float lz, float hx, float hy, flo
     ia = i_lo;                                   \
   }
 
-// Closest hits of the bundle: per lane the hit record (0xffffffff = none) and distance. At an
-// inner node all four children are tested; the entered ones (by any lane) are visited nearest
-// first (by their smallest entry distance), the others wait on the stack.
+// The traversal state of one bundle: its rays (origins, directions, inverse directions per
+// lane), per lane the closest hit so far (distance, record; an inactive lane has distance -1),
+// the node to visit next and the pending nodes.
 // A wide node pushes at most three children and the binary tree is under 72 levels deep (bvh.hpp),
 // so the wide walk's stack never holds more than 3 * 71 + 1 entries.
 #define WIDE_STACK_SIZE 216
-
-inline void closest_hits_bundle(__global const float4* wide, __global const float4* tris,
-                                float8 ox, float8 oy, float8 oz, float8 dx, float8 dy,
-                                float8 dz, int8 active, uint8* f_out, float8* t_out) {
-  const float tiny = 1e-20f;
-  const float8 ix = 1.0f / select(dx, copysign((float8)tiny, dx), fabs(dx) < tiny);
-  const float8 iy = 1.0f / select(dy, copysign((float8)tiny, dy), fabs(dy) < tiny);
-  const float8 iz = 1.0f / select(dz, copysign((float8)tiny, dz), fabs(dz) < tiny);
-  float8 best_t = select((float8)(-1.0f), (float8)INFINITY, active);
-  uint8 best_f = (uint8)0xffffffffu;
+typedef struct {
+  float8 ox, oy, oz, dx, dy, dz, ix, iy, iz, best_t;
+  uint8 best_f;
+  uint word, count;  // the node to visit next
+  int sp;
   uint stack_word[WIDE_STACK_SIZE], stack_count[WIDE_STACK_SIZE];
   float stack_t[WIDE_STACK_SIZE];
-  int sp = 0;
-  uint word = 0, count = 0;  // the root, an inner node
-  for (;;) {
-    if (count & LEAF_BIT) {
-      const uint end = word + (count & ~LEAF_BIT);
-      for (uint k = word; k < end; ++k) {
-        const float4 v0 = tris[3 * k], e1 = tris[3 * k + 1], e2 = tris[3 * k + 2];
-        const float8 px = dy * e2.z - dz * e2.y, py = dz * e2.x - dx * e2.z,
-                     pz = dx * e2.y - dy * e2.x;
-        const float8 det = e1.x * px + e1.y * py + e1.z * pz;
-        const float8 inv_det = 1.0f / det;
-        const float8 tx = ox - v0.x, ty = oy - v0.y, tz = oz - v0.z;
-        const float8 u = (tx * px + ty * py + tz * pz) * inv_det;
-        const float8 qx = ty * e1.z - tz * e1.y, qy = tz * e1.x - tx * e1.z,
-                     qz = tx * e1.y - ty * e1.x;
-        const float8 v = (dx * qx + dy * qy + dz * qz) * inv_det;
-        const float8 t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
-        const int8 on = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
-                        (u + v <= 1.0f) & (t > 0.0f);
-        int8 hit = on & (t < best_t);
-        // Exact ties, rare: per lane, the smaller normal wins (sdfkit_normal_before).
-        const uint8 tie = as_uint8(on & (t == best_t) & (best_f != (uint8)0xffffffffu));
-        const uint4 tie4 = tie.lo | tie.hi;
-        const uint2 tie2 = tie4.lo | tie4.hi;
-        if (tie2.x | tie2.y) {
-          const float3 nk = (float3)(v0.w, e1.w, e2.w);
-          int hs[BUNDLE];
-          uint ties[BUNDLE], bfs[BUNDLE];
-          vstore8(hit, 0, hs);
-          vstore8(tie, 0, ties);
-          vstore8(best_f, 0, bfs);
-          for (int l = 0; l < BUNDLE; ++l)
-            if (ties[l] && sdfkit_normal_before(nk, sdfkit_record_normal(tris, bfs[l]))) hs[l] = -1;
-          hit = vload8(0, hs);
-        }
-        best_t = select(best_t, t, hit);
-        best_f = select(best_f, (uint8)k, as_uint8(hit));
+} sdfkit_bundle;
+
+// Starts the walk of the rays o + t d (t > 0) of the active lanes at the root.
+__attribute__((always_inline)) inline void bundle_start(sdfkit_bundle* b, float8 ox, float8 oy,
+                                                        float8 oz, float8 dx, float8 dy,
+                                                        float8 dz, int8 active) {
+  const float tiny = 1e-20f;
+  b->ox = ox;
+  b->oy = oy;
+  b->oz = oz;
+  b->dx = dx;
+  b->dy = dy;
+  b->dz = dz;
+  b->ix = 1.0f / select(dx, copysign((float8)tiny, dx), fabs(dx) < tiny);
+  b->iy = 1.0f / select(dy, copysign((float8)tiny, dy), fabs(dy) < tiny);
+  b->iz = 1.0f / select(dz, copysign((float8)tiny, dz), fabs(dz) < tiny);
+  b->best_t = select((float8)(-1.0f), (float8)INFINITY, active);
+  b->best_f = (uint8)0xffffffffu;
+  b->word = 0;  // the root, an inner node
+  b->count = 0;
+  b->sp = 0;
+}
+
+// One step of the closest-hit walk: visits the node b->word / b->count and chooses the next.
+// At an inner node all four children are tested; the entered ones (by any lane) are visited
+// nearest first (by their smallest entry distance), the others wait on the stack. Returns false
+// when no node is left (b->best_f / b->best_t are then the closest hits, 0xffffffff = none).
+// The node chosen next is prefetched, so a caller that interleaves two bundles' steps (see
+// trace_bundles) has its load under way while the other bundle's step runs.
+__attribute__((always_inline)) inline bool bundle_step(__global const float4* wide,
+                                                       __global const float4* tris,
+                                                       sdfkit_bundle* b) {
+  const float8 ox = b->ox, oy = b->oy, oz = b->oz, dx = b->dx, dy = b->dy, dz = b->dz;
+  const uint word = b->word, count = b->count;
+  if (count & LEAF_BIT) {
+    float8 best_t = b->best_t;
+    uint8 best_f = b->best_f;
+    const uint end = word + (count & ~LEAF_BIT);
+    for (uint k = word; k < end; ++k) {
+      const float4 v0 = tris[3 * k], e1 = tris[3 * k + 1], e2 = tris[3 * k + 2];
+      const float8 px = dy * e2.z - dz * e2.y, py = dz * e2.x - dx * e2.z,
+                   pz = dx * e2.y - dy * e2.x;
+      const float8 det = e1.x * px + e1.y * py + e1.z * pz;
+      const float8 inv_det = 1.0f / det;
+      const float8 tx = ox - v0.x, ty = oy - v0.y, tz = oz - v0.z;
+      const float8 u = (tx * px + ty * py + tz * pz) * inv_det;
+      const float8 qx = ty * e1.z - tz * e1.y, qy = tz * e1.x - tx * e1.z,
+                   qz = tx * e1.y - ty * e1.x;
+      const float8 v = (dx * qx + dy * qy + dz * qz) * inv_det;
+      const float8 t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
+      const int8 on = (det != 0.0f) & (u >= 0.0f) & (u <= 1.0f) & (v >= 0.0f) &
+                      (u + v <= 1.0f) & (t > 0.0f);
+      int8 hit = on & (t < best_t);
+      // Exact ties, rare: per lane, the smaller normal wins (sdfkit_normal_before).
+      const uint8 tie = as_uint8(on & (t == best_t) & (best_f != (uint8)0xffffffffu));
+      const uint4 tie4 = tie.lo | tie.hi;
+      const uint2 tie2 = tie4.lo | tie4.hi;
+      if (tie2.x | tie2.y) {
+        const float3 nk = (float3)(v0.w, e1.w, e2.w);
+        int hs[BUNDLE];
+        uint ties[BUNDLE], bfs[BUNDLE];
+        vstore8(hit, 0, hs);
+        vstore8(tie, 0, ties);
+        vstore8(best_f, 0, bfs);
+        for (int l = 0; l < BUNDLE; ++l)
+          if (ties[l] && sdfkit_normal_before(nk, sdfkit_record_normal(tris, bfs[l]))) hs[l] = -1;
+        hit = vload8(0, hs);
       }
-    } else {
-      __global const float4* node = wide + 8 * word;
-      const float4 lx = node[0], ly = node[1], lz = node[2], hx = node[3], hy = node[4],
-                   hz = node[5];
-      const uint4 words = as_uint4(node[6]), counts = as_uint4(node[7]);
-      const float8 e0 = bundle_entry(lx.x, ly.x, lz.x, hx.x, hy.x, hz.x, ox, oy, oz, ix, iy, iz, best_t);
-      const float8 e1 = bundle_entry(lx.y, ly.y, lz.y, hx.y, hy.y, hz.y, ox, oy, oz, ix, iy, iz, best_t);
-      const float8 e2 = bundle_entry(lx.z, ly.z, lz.z, hx.z, hy.z, hz.z, ox, oy, oz, ix, iy, iz, best_t);
-      const float8 e3 = bundle_entry(lx.w, ly.w, lz.w, hx.w, hy.w, hz.w, ox, oy, oz, ix, iy, iz, best_t);
-      const float2 m01 = pair_min(e0, e1), m23 = pair_min(e2, e3);
-      // Nearest entry per child (INFINITY: no lane enters it, or an unused slot).
-      float t0 = counts.x == LEAF_BIT ? INFINITY : m01.x, t1 = counts.y == LEAF_BIT ? INFINITY : m01.y;
-      float t2 = counts.z == LEAF_BIT ? INFINITY : m23.x, t3 = counts.w == LEAF_BIT ? INFINITY : m23.y;
-      uint i0 = 0, i1 = 1, i2 = 2, i3 = 3;
-      SDFKIT_ORDER(t0, i0, t1, i1);
-      SDFKIT_ORDER(t2, i2, t3, i3);
-      SDFKIT_ORDER(t0, i0, t2, i2);
-      SDFKIT_ORDER(t1, i1, t3, i3);
-      SDFKIT_ORDER(t1, i1, t2, i2);
-      if (t0 < INFINITY) {
-        const uint ws[4] = {words.x, words.y, words.z, words.w};
-        const uint cs[4] = {counts.x, counts.y, counts.z, counts.w};
-        // Farthest first, so the nearer ones are popped first.
-        if (t3 < INFINITY && sp < WIDE_STACK_SIZE) {
-          stack_word[sp] = ws[i3];
-          stack_count[sp] = cs[i3];
-          stack_t[sp++] = t3;
-          sdfkit_prefetch_child(wide, tris, ws[i3], cs[i3]);
-        }
-        if (t2 < INFINITY && sp < WIDE_STACK_SIZE) {
-          stack_word[sp] = ws[i2];
-          stack_count[sp] = cs[i2];
-          stack_t[sp++] = t2;
-          sdfkit_prefetch_child(wide, tris, ws[i2], cs[i2]);
-        }
-        if (t1 < INFINITY && sp < WIDE_STACK_SIZE) {
-          stack_word[sp] = ws[i1];
-          stack_count[sp] = cs[i1];
-          stack_t[sp++] = t1;
-          sdfkit_prefetch_child(wide, tris, ws[i1], cs[i1]);
-        }
-        word = ws[i0];
-        count = cs[i0];
-        continue;
-      }
+      best_t = select(best_t, t, hit);
+      best_f = select(best_f, (uint8)k, as_uint8(hit));
     }
-    for (;;) {
-      if (sp == 0) {
-        *f_out = best_f;
-        *t_out = best_t;
-        return;
+    b->best_t = best_t;
+    b->best_f = best_f;
+  } else {
+    const float8 ix = b->ix, iy = b->iy, iz = b->iz, best_t = b->best_t;
+    __global const float4* node = wide + 8 * word;
+    const float4 lx = node[0], ly = node[1], lz = node[2], hx = node[3], hy = node[4],
+                 hz = node[5];
+    const uint4 words = as_uint4(node[6]), counts = as_uint4(node[7]);
+    const float8 e0 = bundle_entry(lx.x, ly.x, lz.x, hx.x, hy.x, hz.x, ox, oy, oz, ix, iy, iz, best_t);
+    const float8 e1 = bundle_entry(lx.y, ly.y, lz.y, hx.y, hy.y, hz.y, ox, oy, oz, ix, iy, iz, best_t);
+    const float8 e2 = bundle_entry(lx.z, ly.z, lz.z, hx.z, hy.z, hz.z, ox, oy, oz, ix, iy, iz, best_t);
+    const float8 e3 = bundle_entry(lx.w, ly.w, lz.w, hx.w, hy.w, hz.w, ox, oy, oz, ix, iy, iz, best_t);
+    const float2 m01 = pair_min(e0, e1), m23 = pair_min(e2, e3);
+    // Nearest entry per child (INFINITY: no lane enters it, or an unused slot).
+    float t0 = counts.x == LEAF_BIT ? INFINITY : m01.x, t1 = counts.y == LEAF_BIT ? INFINITY : m01.y;
+    float t2 = counts.z == LEAF_BIT ? INFINITY : m23.x, t3 = counts.w == LEAF_BIT ? INFINITY : m23.y;
+    uint i0 = 0, i1 = 1, i2 = 2, i3 = 3;
+    SDFKIT_ORDER(t0, i0, t1, i1);
+    SDFKIT_ORDER(t2, i2, t3, i3);
+    SDFKIT_ORDER(t0, i0, t2, i2);
+    SDFKIT_ORDER(t1, i1, t3, i3);
+    SDFKIT_ORDER(t1, i1, t2, i2);
+    if (t0 < INFINITY) {
+      const uint ws[4] = {words.x, words.y, words.z, words.w};
+      const uint cs[4] = {counts.x, counts.y, counts.z, counts.w};
+      int sp = b->sp;
+      // Farthest first, so the nearer ones are popped first.
+      if (t3 < INFINITY && sp < WIDE_STACK_SIZE) {
+        b->stack_word[sp] = ws[i3];
+        b->stack_count[sp] = cs[i3];
+        b->stack_t[sp++] = t3;
+        sdfkit_prefetch_child(wide, tris, ws[i3], cs[i3]);
       }
-      --sp;
-      // A pending node is kept while some ray may still enter it before its closest hit.
-      if (stack_t[sp] <= lane_max(best_t)) {
-        word = stack_word[sp];
-        count = stack_count[sp];
-        break;
+      if (t2 < INFINITY && sp < WIDE_STACK_SIZE) {
+        b->stack_word[sp] = ws[i2];
+        b->stack_count[sp] = cs[i2];
+        b->stack_t[sp++] = t2;
+        sdfkit_prefetch_child(wide, tris, ws[i2], cs[i2]);
       }
+      if (t1 < INFINITY && sp < WIDE_STACK_SIZE) {
+        b->stack_word[sp] = ws[i1];
+        b->stack_count[sp] = cs[i1];
+        b->stack_t[sp++] = t1;
+        sdfkit_prefetch_child(wide, tris, ws[i1], cs[i1]);
+      }
+      b->sp = sp;
+      b->word = ws[i0];
+      b->count = cs[i0];
+      sdfkit_prefetch_child(wide, tris, ws[i0], cs[i0]);
+      return true;
     }
   }
+  // A pending node is kept while some ray may still enter it before its closest hit.
+  const float far_t = lane_max(b->best_t);
+  for (int sp = b->sp; sp > 0;) {
+    --sp;
+    if (b->stack_t[sp] <= far_t) {
+      b->sp = sp;
+      b->word = b->stack_word[sp];
+      b->count = b->stack_count[sp];
+      sdfkit_prefetch_child(wide, tris, b->word, b->count);
+      return true;
+    }
+  }
+  b->sp = 0;
+  return false;
 }
 #undef SDFKIT_ORDER
 
-// One work item per (bundle, ray), ray-major: neighbouring work items trace the same cone
-// direction from neighbouring bundles, so they meet the same nodes and triangles while these
-// are in cache (bundle-major order gave neighbouring work items the other rays of one bundle,
-// whose hits lie all over the far side). Writes the keys of its lanes like trace_rays.
-__kernel void trace_bundles(__global const float4* wide, __global const float4* tris,
-                            __global const float4* points, __global const float4* normals,
-                            __global const float4* table, int n_rays, uint n_points,
-                            float origin_offset, int rule, __global ulong* keys) {
-  const uint bundles = (n_points + BUNDLE - 1) / BUNDLE;
-  const uint g = get_global_id(0);
-  if (g >= bundles * (uint)n_rays) return;
-  const uint r = g / bundles, bundle = g - r * bundles;
+// Loads ray r of bundle `bundle` (lanes past the last point repeat it, inactive) into b.
+__attribute__((always_inline)) inline void bundle_load(sdfkit_bundle* b, __global const float4* points,
+                                                       __global const float4* normals,
+                                                       float3 cone_dir, uint bundle, uint n_points,
+                                                       float origin_offset) {
   const uint first = bundle * BUNDLE, lanes = min((uint)BUNDLE, n_points - first);
-  const float3 cone_dir = table[r].xyz;
   float oxs[BUNDLE], oys[BUNDLE], ozs[BUNDLE], dxs[BUNDLE], dys[BUNDLE], dzs[BUNDLE];
   int act[BUNDLE];
   for (uint l = 0; l < BUNDLE; ++l) {
@@ -460,20 +485,30 @@ __kernel void trace_bundles(__global const float4* wide, __global const float4* 
     dxs[l] = d.x; dys[l] = d.y; dzs[l] = d.z;
     act[l] = (l < lanes && pt.w != 0.0f) ? -1 : 0;
   }
-  uint8 f8;
-  float8 t8;
-  closest_hits_bundle(wide, tris, vload8(0, oxs), vload8(0, oys), vload8(0, ozs),
-                      vload8(0, dxs), vload8(0, dys), vload8(0, dzs), vload8(0, act), &f8,
-                      &t8);
+  bundle_start(b, vload8(0, oxs), vload8(0, oys), vload8(0, ozs), vload8(0, dxs), vload8(0, dys),
+               vload8(0, dzs), vload8(0, act));
+}
+
+// Writes the keys of the walked bundle's lanes like trace_rays (an inactive lane has no hit).
+__attribute__((always_inline)) inline void bundle_store(const sdfkit_bundle* b,
+                                                        __global const float4* tris,
+                                                        __global const float4* normals,
+                                                        int n_rays, uint r, uint bundle,
+                                                        uint n_points, int rule,
+                                                        __global ulong* keys) {
+  const uint first = bundle * BUNDLE, lanes = min((uint)BUNDLE, n_points - first);
   uint fs[BUNDLE];
-  float ts[BUNDLE];
-  vstore8(f8, 0, fs);
-  vstore8(t8, 0, ts);
+  float ts[BUNDLE], dxs[BUNDLE], dys[BUNDLE], dzs[BUNDLE];
+  vstore8(b->best_f, 0, fs);
+  vstore8(b->best_t, 0, ts);
+  vstore8(b->dx, 0, dxs);
+  vstore8(b->dy, 0, dys);
+  vstore8(b->dz, 0, dzs);
   for (uint l = 0; l < lanes; ++l) {
     const uint p = first + l;
     ulong key = NO_HIT_KEY;
     const uint f = fs[l];
-    if (act[l] && f != 0xffffffffu) {
+    if (f != 0xffffffffu) {
       const float3 n = normals[p].xyz;
       const float3 hn = (float3)(tris[3 * f].w, tris[3 * f + 1].w, tris[3 * f + 2].w);
       const float3 d = (float3)(dxs[l], dys[l], dzs[l]);
@@ -482,5 +517,75 @@ __kernel void trace_bundles(__global const float4* wide, __global const float4* 
     keys[(size_t)p * n_rays + r] = key;
   }
 }
+
+// One work item per (bundle, ray), ray-major: neighbouring work items trace the same cone
+// direction from neighbouring bundles, so they meet the same nodes and triangles while these
+// are in cache (bundle-major order gave neighbouring work items the other rays of one bundle,
+// whose hits lie all over the far side). Writes the keys of its lanes like trace_rays.
+// SDFKIT_BUNDLES_PER_ITEM (2 or 4 on CPU devices, from the host): a work item walks ray r of
+// that many neighbouring bundles, alternating their steps, so the load of the node one bundle
+// visits next (prefetched when it is chosen) is under way while the other bundles' nodes are
+// tested: a CPU runs a work item as one thread, and the walk otherwise waits on the first load
+// of every node it enters. Each bundle visits its nodes in the same order as alone, so its hits
+// are the same.
+#ifndef SDFKIT_BUNDLES_PER_ITEM
+#define SDFKIT_BUNDLES_PER_ITEM 1
+#endif
+#if SDFKIT_BUNDLES_PER_ITEM != 1 && SDFKIT_BUNDLES_PER_ITEM != 2 && SDFKIT_BUNDLES_PER_ITEM != 4
+#error "trace_bundles walks 1, 2 or 4 bundles per work item"
+#endif
+#define SDFKIT_BUNDLE_START(k)                                                                  \
+  sdfkit_bundle s##k;                                                                           \
+  const bool has##k = bundle + k < bundles;                                                     \
+  bool on##k = has##k;                                                                          \
+  if (has##k) bundle_load(&s##k, points, normals, cone_dir, bundle + k, n_points, origin_offset);
+#define SDFKIT_BUNDLE_STEP(k) \
+  if (on##k) on##k = bundle_step(wide, tris, &s##k);
+#define SDFKIT_BUNDLE_END(k) \
+  if (has##k) bundle_store(&s##k, tris, normals, n_rays, r, bundle + k, n_points, rule, keys);
+__kernel void trace_bundles(__global const float4* wide, __global const float4* tris,
+                            __global const float4* points, __global const float4* normals,
+                            __global const float4* table, int n_rays, uint n_points,
+                            float origin_offset, int rule, __global ulong* keys) {
+  const uint per_item = SDFKIT_BUNDLES_PER_ITEM;
+  const uint bundles = (n_points + BUNDLE - 1) / BUNDLE;
+  const uint items = (bundles + per_item - 1) / per_item;
+  const uint g = get_global_id(0);
+  if (g >= items * (uint)n_rays) return;
+  const uint r = g / items, bundle = (g - r * items) * per_item;
+  const float3 cone_dir = table[r].xyz;
+#if SDFKIT_BUNDLES_PER_ITEM == 1
+  SDFKIT_BUNDLE_START(0)
+  while (on0) SDFKIT_BUNDLE_STEP(0)
+  SDFKIT_BUNDLE_END(0)
+#elif SDFKIT_BUNDLES_PER_ITEM == 2
+  SDFKIT_BUNDLE_START(0)
+  SDFKIT_BUNDLE_START(1)
+  while (on0 || on1) {
+    SDFKIT_BUNDLE_STEP(0)
+    SDFKIT_BUNDLE_STEP(1)
+  }
+  SDFKIT_BUNDLE_END(0)
+  SDFKIT_BUNDLE_END(1)
+#else
+  SDFKIT_BUNDLE_START(0)
+  SDFKIT_BUNDLE_START(1)
+  SDFKIT_BUNDLE_START(2)
+  SDFKIT_BUNDLE_START(3)
+  while (on0 || on1 || on2 || on3) {
+    SDFKIT_BUNDLE_STEP(0)
+    SDFKIT_BUNDLE_STEP(1)
+    SDFKIT_BUNDLE_STEP(2)
+    SDFKIT_BUNDLE_STEP(3)
+  }
+  SDFKIT_BUNDLE_END(0)
+  SDFKIT_BUNDLE_END(1)
+  SDFKIT_BUNDLE_END(2)
+  SDFKIT_BUNDLE_END(3)
+#endif
+}
+#undef SDFKIT_BUNDLE_START
+#undef SDFKIT_BUNDLE_STEP
+#undef SDFKIT_BUNDLE_END
 #endif
 

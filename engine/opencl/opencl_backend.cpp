@@ -108,6 +108,10 @@ void set_args(cl_kernel kernel, const char* kernel_name, const Args&... args) {
 constexpr std::size_t kCpuWorkGroup = 8;
 // Points per work item of trace_bundles (cl/sdf_trace.cl, given as SDFKIT_BUNDLE_WIDTH).
 constexpr std::size_t kBundle = 8;
+// Bundles a trace_bundles work item walks on CPU devices, their steps alternated so that one
+// bundle's next node loads while the others' are tested (cl/sdf_trace.cl). Level 3 of the huge
+// bench, user CPU of the whole process: 4 bundles -11 %, 2 bundles -5 % (bench/RESULTS.md).
+constexpr std::size_t kCpuBundlesPerItem = 4;
 // Most points per batch on CPU devices, whose buffers are host memory beside the process's own:
 // 2^16 points at 30 rays are 17.5 MiB of batch buffers instead of the 512 MiB cap (2^18 and
 // 2^17 held 35 and 17.5 MiB more at the 13M-triangle run's peak, which is the trace's), and a
@@ -379,6 +383,7 @@ struct OpenClBackend::Impl {
   detail::Kernel k_trace, k_bundles, k_gather, k_dirs;
   bool bundles = false;  // BVH traced by trace_bundles, over the 4-wide copy (WideNode)
   std::size_t local_size = 0;  // work-group size of the trace and gather kernels (0 = driver's)
+  std::size_t bundles_per_item = 1;  // bundles a trace_bundles work item walks (kCpuBundlesPerItem on CPUs)
 
   // Geometry (resident between computes). The host keeps no positions (update_positions brings
   // all of them again), only the triangles a rebuild needs: the caller's shared mesh
@@ -486,8 +491,11 @@ void OpenClBackend::Impl::build_program() {
   const int stack = 7 * std::max(config.octree_max_depth, 1) + 2;
   std::string options = "-cl-std=CL1.2 -DSTACK_SIZE=" + std::to_string(stack);
   if (config.accel == Accel::Bvh) options += " -DSDFKIT_BVH=1 -DSDFKIT_BUNDLE_WIDTH=" + std::to_string(kBundle);
-  // CPU devices: software prefetches in the bundle traversal (cl/sdf_trace.cl).
+  // CPU devices: software prefetches in the bundle traversal, kCpuBundlesPerItem bundles per
+  // work item (cl/sdf_trace.cl's trace_bundles).
+  bundles_per_item = info.type == "CPU" ? kCpuBundlesPerItem : 1;
   if (info.type == "CPU") options += " -DSDFKIT_PREFETCH=1";
+  options += " -DSDFKIT_BUNDLES_PER_ITEM=" + std::to_string(bundles_per_item);
   cl_device_fp_config fp = 0;
   check(clGetDeviceInfo(device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, nullptr),
         "querying the device's float support");
@@ -822,11 +830,14 @@ RawSdf OpenClBackend::compute(const SdfQuery& query, const SdfOptions& options) 
                                nullptr, nullptr),
           "uploading query normals");
     if (m.bundles) {
-      // Ray r of kBundle Morton-neighbouring points per work item (cl/sdf_trace.cl).
+      // Ray r of kBundle Morton-neighbouring points per bundle, bundles_per_item neighbouring
+      // bundles per work item (cl/sdf_trace.cl).
       set_args(m.k_bundles.get(), "trace_bundles", m.cells.get(), m.tris.get(), m.points.get(),
                m.normals.get(), m.table.get(), cl_int{rays}, count32, query.origin_offset, rule,
                m.keys.get());
-      m.run(m.k_bundles.get(), (count + kBundle - 1) / kBundle * nr, m.local_size, "trace_bundles");
+      const std::size_t bundles = (count + kBundle - 1) / kBundle;
+      m.run(m.k_bundles.get(), (bundles + m.bundles_per_item - 1) / m.bundles_per_item * nr, m.local_size,
+            "trace_bundles");
     } else {
       set_args(m.k_trace.get(), "trace_rays", m.nodes.get(), m.cells.get(), m.tris.get(),
                m.points.get(), m.normals.get(), m.table.get(), cl_int{rays}, count32,
