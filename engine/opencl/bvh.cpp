@@ -198,17 +198,21 @@ struct Builder {
   void bin(std::size_t begin, std::size_t end, int bins, const Box& cbounds, const glm::vec3& scale,
            Bins& out, bool parallel) const {
     // rel = (centroid - cbounds.lo) * scale and its truncation, lane for lane as in glm.
-    const __m128 clo = vec4(cbounds.lo), sc = vec4(scale);
+    // rel >= 0 (a centroid is not below cbounds.lo), so truncating min(rel, bins - 1) is
+    // min(bins - 1, truncated rel); an infinite or NaN rel (a denormal extent) goes to the last
+    // bin instead of a negative index.
+    const __m128 clo = vec4(cbounds.lo), sc = vec4(scale), last = _mm_set1_ps(static_cast<float>(bins - 1));
     const auto bin_one = [&](const Ref& ref, Bins& r) {
       const __m128 lo = ref_lo(ref), hi = ref_hi(ref);
-      alignas(16) std::int32_t k[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(k), _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centroid4(lo, hi), clo), sc)));
-      for (int axis = 0; axis < 3; ++axis) {
-        const int kk = std::min(bins - 1, k[axis]);
+      const __m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_mul_ps(_mm_sub_ps(centroid4(lo, hi), clo), sc), last));
+      const auto update = [&](int axis, int kk) {
         r.lo[axis][kk] = _mm_min_ps(lo, r.lo[axis][kk]);
         r.hi[axis][kk] = _mm_max_ps(hi, r.hi[axis][kk]);
         ++r.count[axis][kk];
-      }
+      };
+      update(0, _mm_cvtsi128_si32(k));
+      update(1, _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)));
+      update(2, _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2)));
     };
     // Neighbouring refs mostly fall in the same bins, and each update waits for the previous
     // one's store: larger ranges alternate between two sets of bins, merged at the end. (The
@@ -223,6 +227,14 @@ struct Builder {
       Bins other;
       other.reset(bins);
       std::size_t i = b;
+      if (e - b >= 1024) {  // four sets: longer chains apart
+        Bins third, fourth;
+        third.reset(bins), fourth.reset(bins);
+        for (; i + 3 < e; i += 4)
+          bin_one(refs[i], r), bin_one(refs[i + 1], other), bin_one(refs[i + 2], third), bin_one(refs[i + 3], fourth);
+        merge(other, third, bins);
+        merge(r, fourth, bins);
+      }
       for (; i + 1 < e; i += 2) bin_one(refs[i], r), bin_one(refs[i + 1], other);
       if (i < e) bin_one(refs[i], r);
       merge(r, other, bins);
