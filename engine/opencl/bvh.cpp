@@ -11,7 +11,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 #include <limits>
 #include <string>
@@ -164,10 +167,13 @@ struct Bins {
 
 struct Builder {
   BvhParams params;
+  unsigned threads = 1;  // >= 1
   std::vector<Ref, Uninitialized<Ref>> refs;
 
   // Bounds and centroid bounds of refs [begin, end).
-  void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds) const {
+  // `parallel`: on all threads when the range is large (the caller's thread is the only one
+  // building).
+  void measure(std::size_t begin, std::size_t end, Box& bounds, Box& cbounds, bool parallel) const {
     const auto pass = [&](std::size_t b, std::size_t e, Box& bb, Box& cb) {
       Box4 b4, c4;
       for (std::size_t i = b; i < e; ++i) {
@@ -178,31 +184,35 @@ struct Builder {
       bb.grow(b4.box());
       cb.grow(c4.box());
     };
-    if (end - begin < kParallelBinning) return pass(begin, end, bounds, cbounds);
-    std::vector<Box> bb(std::thread::hardware_concurrency() + 1), cb(bb.size());
+    if (!parallel || end - begin < kParallelBinning) return pass(begin, end, bounds, cbounds);
+    std::vector<Box> bb(threads), cb(bb.size());
     std::atomic<std::size_t> slot{0};
     parallel_for(end - begin, [&](std::size_t b, std::size_t e) {
       const std::size_t k = slot++;
       pass(begin + b, begin + e, bb[k], cb[k]);
-    }, kParallelBinning / 2);
+    }, kParallelBinning / 2, threads);
     for (std::size_t k = 0; k < bb.size(); ++k) bounds.grow(bb[k]), cbounds.grow(cb[k]);
   }
 
   // Bins refs [begin, end) by centroid on the three axes.
   void bin(std::size_t begin, std::size_t end, int bins, const Box& cbounds, const glm::vec3& scale,
-           Bins& out) const {
+           Bins& out, bool parallel) const {
     // rel = (centroid - cbounds.lo) * scale and its truncation, lane for lane as in glm.
-    const __m128 clo = vec4(cbounds.lo), sc = vec4(scale);
+    // rel >= 0 (a centroid is not below cbounds.lo), so truncating min(rel, bins - 1) is
+    // min(bins - 1, truncated rel); an infinite or NaN rel (a denormal extent) goes to the last
+    // bin instead of a negative index.
+    const __m128 clo = vec4(cbounds.lo), sc = vec4(scale), last = _mm_set1_ps(static_cast<float>(bins - 1));
     const auto bin_one = [&](const Ref& ref, Bins& r) {
       const __m128 lo = ref_lo(ref), hi = ref_hi(ref);
-      alignas(16) std::int32_t k[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(k), _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centroid4(lo, hi), clo), sc)));
-      for (int axis = 0; axis < 3; ++axis) {
-        const int kk = std::min(bins - 1, k[axis]);
+      const __m128i k = _mm_cvttps_epi32(_mm_min_ps(_mm_mul_ps(_mm_sub_ps(centroid4(lo, hi), clo), sc), last));
+      const auto update = [&](int axis, int kk) {
         r.lo[axis][kk] = _mm_min_ps(lo, r.lo[axis][kk]);
         r.hi[axis][kk] = _mm_max_ps(hi, r.hi[axis][kk]);
         ++r.count[axis][kk];
-      }
+      };
+      update(0, _mm_cvtsi128_si32(k));
+      update(1, _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 1)));
+      update(2, _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 2)));
     };
     // Neighbouring refs mostly fall in the same bins, and each update waits for the previous
     // one's store: larger ranges alternate between two sets of bins, merged at the end. (The
@@ -217,16 +227,24 @@ struct Builder {
       Bins other;
       other.reset(bins);
       std::size_t i = b;
+      if (e - b >= 1024) {  // four sets: longer chains apart
+        Bins third, fourth;
+        third.reset(bins), fourth.reset(bins);
+        for (; i + 3 < e; i += 4)
+          bin_one(refs[i], r), bin_one(refs[i + 1], other), bin_one(refs[i + 2], third), bin_one(refs[i + 3], fourth);
+        merge(other, third, bins);
+        merge(r, fourth, bins);
+      }
       for (; i + 1 < e; i += 2) bin_one(refs[i], r), bin_one(refs[i + 1], other);
       if (i < e) bin_one(refs[i], r);
       merge(r, other, bins);
     };
-    if (end - begin < kParallelBinning) return pass(begin, end, out);
-    std::vector<Bins> partial(std::thread::hardware_concurrency() + 1);
+    if (!parallel || end - begin < kParallelBinning) return pass(begin, end, out);
+    std::vector<Bins> partial(threads);
     for (Bins& p : partial) p.reset(bins);
     std::atomic<std::size_t> slot{0};
     parallel_for(end - begin, [&](std::size_t b, std::size_t e) { pass(begin + b, begin + e, partial[slot++]); },
-                 kParallelBinning / 2);
+                 kParallelBinning / 2, threads);
     out.reset(bins);
     for (const Bins& p : partial) merge(out, p, bins);
   }
@@ -281,11 +299,11 @@ struct Builder {
 
   // Bounds of refs [begin, end) and the split the SAH (or the object median) chooses; a split
   // partitions the range in place. Subtrees over disjoint ranges may be built concurrently.
-  Split choose(std::size_t begin, std::size_t end, int depth, Known known = {}) {
+  Split choose(std::size_t begin, std::size_t end, int depth, Known known, bool parallel_passes) {
     Split s;
     Box cbounds;
     if (known.bounds) s.bounds = *known.bounds, cbounds = *known.cbounds;
-    else measure(begin, end, s.bounds, cbounds);
+    else measure(begin, end, s.bounds, cbounds, parallel_passes);
     const std::size_t n = end - begin;
     if (n <= 1) return s;
     std::size_t mid = begin;
@@ -300,7 +318,7 @@ struct Builder {
       for (int axis = 0; axis < 3; ++axis)
         if (extent[axis] > 0.0f) scale[axis] = static_cast<float>(bins) / extent[axis];
       Bins binned;  // reset by bin
-      bin(begin, end, bins, cbounds, scale, binned);
+      bin(begin, end, bins, cbounds, scale, binned, parallel_passes);
       float best_cost = std::numeric_limits<float>::max();
       int best_axis = -1, best_split = 0;
       for (int axis = 0; axis < 3; ++axis) {
@@ -362,7 +380,7 @@ struct Builder {
   // Fills node `index` of `t` (already allocated) with refs [begin, end), depth-first.
   void build(Subtree& t, std::uint32_t index, std::size_t begin, std::size_t end, int depth, Known known) {
     t.depth = std::max(t.depth, depth);
-    const Split s = choose(begin, end, depth, known);
+    const Split s = choose(begin, end, depth, known, false);
     set_bounds(t.nodes[index], s.bounds);
     if (s.leaf) return make_leaf(t, index, begin, end);
     const auto left = static_cast<std::uint32_t>(t.nodes.size());
@@ -385,104 +403,110 @@ struct Builder {
     ++t.leaf_count;
   }
 
-  // The top of the tree, split on the calling thread (with parallel binning) until every part
-  // holds at most `task_size` triangles; the parts become subtree tasks.
+  // The top of the tree: nodes with more than `task_size` triangles. The root is split on the
+  // calling thread (its passes on all threads); then every thread takes the largest node left,
+  // splits it (its children join the queue) or, at most `task_size` triangles, builds its whole
+  // subtree. The split of a node depends only on its own triangles, so the tree does not depend
+  // on which thread took what.
   struct Top {
     Split split;
     std::size_t begin = 0, end = 0;
     int depth = 0;
-    int child[2] = {-1, -1};  // internal: Top indices
-    int task = -1;             // a part built as a task
-    bool known = false;        // a task's bounds, measured by its parent's partition
+    Top* child[2] = {nullptr, nullptr};  // internal
+    bool task = false;                   // a part, built whole
+    bool known = false;                  // bounds measured by the parent's partition
     Box bounds, cbounds;
+    Subtree part;
+    std::size_t at = 0;  // a part: where its nodes go
+    Known given() const { return known ? Known{&bounds, &cbounds} : Known{}; }
   };
-  int split_top(std::vector<Top>& top, std::vector<int>& tasks, std::size_t begin, std::size_t end, int depth,
-                std::size_t task_size, Known known) {
-    const int index = static_cast<int>(top.size());
-    top.push_back({});
-    top[static_cast<std::size_t>(index)].begin = begin;
-    top[static_cast<std::size_t>(index)].end = end;
-    top[static_cast<std::size_t>(index)].depth = depth;
-    if (end - begin <= task_size) {
-      Top& t = top[static_cast<std::size_t>(index)];
-      t.task = static_cast<int>(tasks.size());
-      if (known.bounds) t.known = true, t.bounds = *known.bounds, t.cbounds = *known.cbounds;
-      tasks.push_back(index);
-      return index;
-    }
-    const Split s = choose(begin, end, depth, known);
-    top[static_cast<std::size_t>(index)].split = s;
-    if (s.leaf) return index;
-    const int l = split_top(top, tasks, begin, s.mid, depth + 1, task_size,
-                            child_known(s, 0));
-    const int r = split_top(top, tasks, s.mid, end, depth + 1, task_size,
-                            child_known(s, 1));
-    top[static_cast<std::size_t>(index)].child[0] = l;
-    top[static_cast<std::size_t>(index)].child[1] = r;
-    return index;
-  }
 
-  // The whole tree: the top split here, its parts built by all threads (each takes the next
-  // part), then laid out depth-first exactly as a sequential build would.
-  Bvh build_all() {
+  // The whole tree: the top split and its parts built by all threads, then laid out depth-first
+  // exactly as a sequential build would.
+  Bvh build_all(Known root_known) {
     const std::size_t n = refs.size();
-    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     // Large meshes: parts of ~1/16 of the triangles per thread keep the threads busy to the
     // end. Small ones: the root's two halves, as the top costs more than imbalance there.
     const std::size_t task_size = n < kParallelBelow || threads == 1 ? n
                                   : n < (std::size_t{1} << 20)        ? (n + 1) / 2
                                                                       : n / (16 * threads);
-    std::vector<Top> top;
-    std::vector<int> tasks;
-    split_top(top, tasks, 0, n, 0, task_size, {});
-    std::vector<Subtree> parts(tasks.size());  // each freed once laid out below
-    // Largest parts first.
-    std::vector<std::size_t> schedule(tasks.size());
-    for (std::size_t k = 0; k < schedule.size(); ++k) schedule[k] = k;
-    std::sort(schedule.begin(), schedule.end(), [&](std::size_t a, std::size_t b) {
-      const Top& ta = top[static_cast<std::size_t>(tasks[a])];
-      const Top& tb = top[static_cast<std::size_t>(tasks[b])];
-      return ta.end - ta.begin > tb.end - tb.begin;
-    });
-    std::atomic<std::size_t> next{0};
+    std::vector<std::unique_ptr<Top>> top;  // a node's address is stable; the vector is locked
+    std::vector<Top*> pending, tasks;
+    std::mutex lock;
+    std::condition_variable wake;
+    std::size_t busy = 0;
+    // Under the lock.
+    const auto add = [&](std::size_t begin, std::size_t end, int depth, Known known) {
+      top.push_back(std::make_unique<Top>());
+      Top* t = top.back().get();
+      t->begin = begin, t->end = end, t->depth = depth;
+      if (known.bounds) t->known = true, t->bounds = *known.bounds, t->cbounds = *known.cbounds;
+      pending.push_back(t);
+      return t;
+    };
+    const auto split = [&](Top& t, bool parallel_passes) {
+      t.split = choose(t.begin, t.end, t.depth, t.given(), parallel_passes);
+      if (t.split.leaf) return;
+      const std::scoped_lock guard(lock);
+      t.child[0] = add(t.begin, t.split.mid, t.depth + 1, child_known(t.split, 0));
+      t.child[1] = add(t.split.mid, t.end, t.depth + 1, child_known(t.split, 1));
+    };
+    Top* root = add(0, n, 0, root_known);
+    if (n > task_size) {
+      pending.clear();
+      split(*root, true);
+    }
     const auto worker = [&] {
-      for (std::size_t k; (k = next++) < schedule.size();) {
-        const Top& t = top[static_cast<std::size_t>(tasks[schedule[k]])];
-        Subtree& part = parts[schedule[k]];
-        // At most 2m - 1 nodes for m triangles: no reallocation (and copy) while it grows; only
-        // the pages it fills are touched.
-        part.nodes.reserve(2 * (t.end - t.begin));
-        part.nodes.emplace_back();
-        build(part, 0, t.begin, t.end, t.depth, t.known ? Known{&t.bounds, &t.cbounds} : Known{});
+      for (;;) {
+        Top* t = nullptr;
+        {
+          std::unique_lock<std::mutex> guard(lock);
+          wake.wait(guard, [&] { return !pending.empty() || busy == 0; });
+          if (pending.empty()) return;  // and no thread can add more
+          const auto largest = std::max_element(pending.begin(), pending.end(), [](const Top* a, const Top* b) {
+            return a->end - a->begin < b->end - b->begin;
+          });
+          t = *largest;
+          pending.erase(largest);
+          ++busy;
+        }
+        if (t->end - t->begin > task_size) {
+          split(*t, false);
+        } else {
+          t->task = true;
+          // At most 2m - 1 nodes for m triangles: no reallocation (and copy) while it grows;
+          // only the pages it fills are touched.
+          t->part.nodes.reserve(2 * (t->end - t->begin));
+          t->part.nodes.emplace_back();
+          build(t->part, 0, t->begin, t->end, t->depth, t->given());
+        }
+        {
+          const std::scoped_lock guard(lock);
+          --busy;
+          if (t->task) tasks.push_back(t);
+        }
+        wake.notify_all();
       }
     };
-    {
-      std::vector<std::thread> pool;
-      const std::size_t helpers = std::min<std::size_t>(threads, tasks.size()) - 1;
-      for (std::size_t k = 0; k < helpers; ++k) pool.emplace_back(worker);
-      worker();
-      for (std::thread& th : pool) th.join();
-    }
+    parallel_for(threads, [&](std::size_t, std::size_t) { worker(); }, 1, threads);
+    // The copy below takes the largest parts first.
+    std::sort(tasks.begin(), tasks.end(), [](const Top* a, const Top* b) { return a->end - a->begin > b->end - b->begin; });
 
     // The layout: the top's nodes written here in depth-first order, each part's block placed
     // where its subtree goes; the parts are then copied (their child indices shifted) on all
     // threads.
     Bvh out;
     std::size_t total = 0;
-    for (const Top& t : top) total += t.task < 0 ? 1 : 0;
-    for (const Subtree& p : parts) total += p.nodes.size();
+    for (const auto& t : top) total += t->task ? t->part.nodes.size() : 1;
     out.nodes.resize(total);
-    std::vector<std::size_t> part_at(parts.size(), 0);
     std::size_t at = 0;
-    const auto emit = [&](auto&& self, int index) -> void {
-      const Top& t = top[static_cast<std::size_t>(index)];
+    const auto emit = [&](auto&& self, Top& t) -> void {
       out.depth = std::max(out.depth, t.depth);
-      if (t.task >= 0) {
-        const Subtree& p = parts[static_cast<std::size_t>(t.task)];
-        part_at[static_cast<std::size_t>(t.task)] = at;
-        at += p.nodes.size();
-        out.depth = std::max(out.depth, p.depth);
-        out.leaf_count += p.leaf_count;
+      if (t.task) {
+        t.at = at;
+        at += t.part.nodes.size();
+        out.depth = std::max(out.depth, t.part.depth);
+        out.leaf_count += t.part.leaf_count;
         return;
       }
       const std::size_t here = at++;
@@ -493,17 +517,17 @@ struct Builder {
         ++out.leaf_count;
         return;
       }
-      self(self, t.child[0]);
+      self(self, *t.child[0]);
       out.nodes[here].first_or_second = static_cast<std::uint32_t>(at);
-      self(self, t.child[1]);
+      self(self, *t.child[1]);
     };
-    emit(emit, 0);
+    emit(emit, *root);
     // Parts differ in size: each thread takes the next one left.
     std::atomic<std::size_t> next_copy{0};
-    parallel_for(parts.size(), [&](std::size_t, std::size_t) {
-      for (std::size_t k; (k = next_copy++) < parts.size();) {
-        Subtree& p = parts[schedule[k]];
-        const auto offset = static_cast<std::uint32_t>(part_at[schedule[k]]);
+    parallel_for(tasks.size(), [&](std::size_t, std::size_t) {
+      for (std::size_t k; (k = next_copy++) < tasks.size();) {
+        Subtree& p = tasks[k]->part;
+        const auto offset = static_cast<std::uint32_t>(tasks[k]->at);
         BvhNode* dst = out.nodes.data() + offset;
         for (std::size_t i = 0; i < p.nodes.size(); ++i) {
           BvhNode node = p.nodes[i];
@@ -516,7 +540,7 @@ struct Builder {
     out.order.resize(n);
     parallel_for(n, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) out.order[i] = refs[i].face;
-    }, 1 << 16);
+    }, 1 << 16, threads);
     return out;
   }
 };
@@ -537,42 +561,66 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
     throw InputError("the BVH leaf size must be at least 1, got " + std::to_string(params.leaf_size));
   if (!(params.traversal_cost > 0.0f) || !std::isfinite(params.traversal_cost))
     throw InputError("the BVH traversal cost must be positive, got " + std::to_string(params.traversal_cost));
-  Builder b{params, {}};
-  const auto degenerate = degenerate_faces(mesh);
-  // Chunks of faces, each filling its own run of refs (after the kept faces of the chunks
-  // before it): face order, on all threads, with no per-face slot table.
+  if (params.threads < 0) throw InputError("the BVH build's thread count must be 0 (all) or more, got " + std::to_string(params.threads));
+  const unsigned threads = params.threads > 0 ? static_cast<unsigned>(params.threads) : std::max(1u, std::thread::hardware_concurrency());
+  Builder b{params, threads, {}};
+  // Chunks of faces, each filling the refs of its kept (non-degenerate, as degenerate_faces
+  // tells them) faces from its first face's slot on, on all threads; then the runs are moved
+  // together (only when some face was left out). Face order, one pass over the triangles.
   const std::size_t faces = mesh.triangles.size();
+  const std::size_t vertices = mesh.positions.size();
   const std::size_t chunks = std::clamp<std::size_t>(faces >> 16, 1, 64);
   const auto chunk_begin = [&](std::size_t c) { return faces * c / chunks; };
-  std::vector<std::size_t> first_ref(chunks + 1, 0);
-  parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
-    for (std::size_t c = cb; c < ce; ++c)
-      first_ref[c + 1] = static_cast<std::size_t>(std::count(degenerate.begin() + static_cast<std::ptrdiff_t>(chunk_begin(c)),
-                                                             degenerate.begin() + static_cast<std::ptrdiff_t>(chunk_begin(c + 1)), 0));
-  }, 1);
-  for (std::size_t c = 0; c < chunks; ++c) first_ref[c + 1] += first_ref[c];
-  b.refs.resize(first_ref[chunks]);
-  // Unpadded boxes, in face order, and the padding (as before: of the boxes' corners).
+  b.refs.resize(faces);
+  std::vector<std::size_t> kept(chunks, 0);
+  // Unpadded boxes and the padding (as before: of the boxes' corners).
   std::vector<float> largest(chunks, 0.0f);
   parallel_for(chunks, [&](std::size_t cb, std::size_t ce) {
     for (std::size_t c = cb; c < ce; ++c) {
       float big = 0.0f;
-      std::size_t k = first_ref[c];
+      std::size_t k = chunk_begin(c);
       for (std::size_t f = chunk_begin(c); f < chunk_begin(c + 1); ++f) {
-        if (degenerate[f]) continue;
+        const Triangle& t = mesh.triangles[f];
+        if (t[0] >= vertices || t[1] >= vertices || t[2] >= vertices) continue;
+        const glm::vec3 &p0 = mesh.positions[t[0]], &p1 = mesh.positions[t[1]], &p2 = mesh.positions[t[2]];
+        if (triangle_is_degenerate(p0, p1, p2)) continue;
         Box box;
-        for (std::uint32_t v : mesh.triangles[f]) box.grow(mesh.positions[v]);
+        box.grow(p0), box.grow(p1), box.grow(p2);
         b.refs[k++] = Ref{box.lo, static_cast<std::uint32_t>(f), box.hi, 0};
         big = std::max({big, glm::length(box.lo), glm::length(box.hi)});
       }
+      kept[c] = k - chunk_begin(c);
       largest[c] = big;
     }
-  }, 1);
+  }, 1, threads);
+  std::size_t total = kept[0];
+  for (std::size_t c = 1; c < chunks; ++c) {
+    // Left, in chunk order: a run never lands on one not yet moved.
+    if (total < chunk_begin(c))
+      std::memmove(&b.refs[total], &b.refs[chunk_begin(c)], kept[c] * sizeof(Ref));
+    total += kept[c];
+  }
+  b.refs.resize(total);
+  // The padding, and with it the root's bounds and centroid bounds (so the root needs no pass
+  // of its own).
   const glm::vec3 pad(1e-6f * *std::max_element(largest.begin(), largest.end()) + std::numeric_limits<float>::min());
+  std::vector<Box> bb(threads), cb(threads);
+  std::atomic<std::size_t> slot{0};
   parallel_for(b.refs.size(), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) b.refs[i].lo -= pad, b.refs[i].hi += pad;
-  }, 1 << 16);
-  return b.build_all();
+    Box4 b4, c4;
+    for (std::size_t i = begin; i < end; ++i) {
+      Ref& r = b.refs[i];
+      r.lo -= pad, r.hi += pad;
+      const __m128 lo = ref_lo(r), hi = ref_hi(r);
+      b4.grow(lo, hi);
+      c4.grow(centroid4(lo, hi));
+    }
+    const std::size_t k = slot++;
+    bb[k] = b4.box(), cb[k] = c4.box();
+  }, 1 << 16, threads);
+  Box bounds, cbounds;
+  for (std::size_t k = 0; k < bb.size(); ++k) bounds.grow(bb[k]), cbounds.grow(cb[k]);
+  return b.build_all(Known{&bounds, &cbounds});
 }
 
 bool refit_bvh(Bvh& bvh, const Mesh& mesh) {
@@ -610,8 +658,22 @@ double sah_cost(const Bvh& bvh) {
     const glm::dvec3 e = glm::dvec3(n.max) - glm::dvec3(n.min);
     return e.x * e.y + e.y * e.z + e.z * e.x;
   };
+  // Summed in fixed blocks (on all threads), then the blocks' sums in order: the same value for
+  // any thread count.
+  constexpr std::size_t kBlock = 1 << 16;
+  std::vector<double> block((bvh.nodes.size() + kBlock - 1) / kBlock, 0.0);
+  parallel_for(block.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      double sum = 0.0;
+      for (std::size_t i = k * kBlock; i < std::min(bvh.nodes.size(), (k + 1) * kBlock); ++i) {
+        const BvhNode& n = bvh.nodes[i];
+        sum += area(n) * (n.is_leaf() ? n.triangles() : 1.0);
+      }
+      block[k] = sum;
+    }
+  }, 8);
   double sum = 0.0;
-  for (const BvhNode& n : bvh.nodes) sum += area(n) * (n.is_leaf() ? n.triangles() : 1.0);
+  for (double s : block) sum += s;
   const double root = area(bvh.nodes[0]);
   return root > 0.0 ? sum / root : 0.0;
 }

@@ -26,6 +26,7 @@ namespace sdfkit::cl {
 struct BvhParams {
   int leaf_size = 4;           // >= 1
   float traversal_cost = 1.0f;  // a node visit in triangle tests, > 0
+  int threads = 0;              // build threads, 0 = all; the tree is the same for any count
 };
 
 // One flattened node, as the device reads it (two float4: min + word, max + word).
