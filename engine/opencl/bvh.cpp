@@ -352,9 +352,11 @@ struct Builder {
       const float split_cost = params.traversal_cost + best_cost / std::max(s.bounds.half_area(), 1e-30f);
       if (n <= static_cast<std::size_t>(params.leaf_size) && (best_axis < 0 || split_cost >= leaf_cost)) return s;
       if (best_axis >= 0) {
-        const float sc = scale[best_axis], lo = cbounds.lo[best_axis];
+        // The bin as bin() takes it: clamped in float before the truncation, so an infinite
+        // or NaN product (a denormal extent) is the last bin, not an out-of-range cast.
+        const float sc = scale[best_axis], lo = cbounds.lo[best_axis], last = static_cast<float>(bins - 1);
         mid = partition_measured(begin, end, s, [&](const Ref& r) {
-          return std::min(bins - 1, static_cast<int>((r.centroid()[best_axis] - lo) * sc)) <= best_split;
+          return static_cast<int>(std::min(last, (r.centroid()[best_axis] - lo) * sc)) <= best_split;
         });
       }
     } else if (n <= static_cast<std::size_t>(params.leaf_size)) {

@@ -453,6 +453,9 @@ void OpenClBackend::Impl::create(const OpenClConfig& cfg) {
     throw InputError("the BVH leaf size and traversal cost must be >= 0 (0 = the tracer's default)");
   if (!(cfg.bvh_refit_limit >= 0.0) || !std::isfinite(cfg.bvh_refit_limit))
     throw InputError("the BVH refit limit must be a finite number >= 0");
+  if (cfg.bvh_bundles_per_item != 0 && cfg.bvh_bundles_per_item != 1 && cfg.bvh_bundles_per_item != 2 &&
+      cfg.bvh_bundles_per_item != 4)
+    throw InputError("the BVH bundles per work item must be 1, 2 or 4 (0 = the device's default)");
   const auto devices = detail::enumerate_devices();
   const std::size_t index = select_device(devices, cfg.device);
   const detail::FoundDevice& d = devices[index];
@@ -493,7 +496,8 @@ void OpenClBackend::Impl::build_program() {
   if (config.accel == Accel::Bvh) options += " -DSDFKIT_BVH=1 -DSDFKIT_BUNDLE_WIDTH=" + std::to_string(kBundle);
   // CPU devices: software prefetches in the bundle traversal, kCpuBundlesPerItem bundles per
   // work item (cl/sdf_trace.cl's trace_bundles).
-  bundles_per_item = info.type == "CPU" ? kCpuBundlesPerItem : 1;
+  bundles_per_item = config.bvh_bundles_per_item != 0 ? config.bvh_bundles_per_item
+                                                      : (info.type == "CPU" ? kCpuBundlesPerItem : 1);
   if (info.type == "CPU") options += " -DSDFKIT_PREFETCH=1";
   options += " -DSDFKIT_BUNDLES_PER_ITEM=" + std::to_string(bundles_per_item);
   cl_device_fp_config fp = 0;

@@ -3,12 +3,14 @@
 // coordinate is special, and a mesh whose vertices lie on the octree's cell planes.
 #include "device_fixture.hpp"
 
+#include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 using namespace sdfkit;
 
@@ -98,3 +100,48 @@ TEST_P(OpenClTrace, ClosestHitEqualsBruteForceOnCellPlanes) {
 
 INSTANTIATE_TEST_SUITE_P(Tracer, OpenClTrace, ::testing::Values(test::Tracer::BvhBundles, test::Tracer::BvhSingle, test::Tracer::Octree),
                          [](const auto& p) { return std::string(test::tracer_name(p.param)); });
+
+// A bundle work item's count of bundles (cl/sdf_trace.cl's SDFKIT_BUNDLES_PER_ITEM) only
+// interleaves the bundles' traversal steps: each bundle visits the same nodes and tests the same
+// triangles in the same order, so 1 (the GPU path), 2 and 4 (the CPU default) must agree bit for
+// bit, including the last work item's missing bundles (405 and 810 bundles are no multiple of 4).
+TEST(OpenClBundlesPerItem, EveryCountGivesTheSameSdfBitForBit) {
+  if (cl::list_devices().empty()) {
+    if (test::allow_no_device()) GTEST_SKIP() << "no OpenCL device (SDFKIT_ALLOW_NO_DEVICE=1)";
+    FAIL() << "no OpenCL device; install pocl-opencl-icd or set SDFKIT_ALLOW_NO_DEVICE=1";
+  }
+  const Mesh mesh = shapes::torus(2.0f, 0.7f, 81, 40);
+  std::vector<RawSdf> first;
+  for (std::size_t per_item : {1, 2, 4}) {
+    cl::OpenClConfig config;
+    config.bvh_bundles = true;
+    config.bvh_bundles_per_item = per_item;
+    cl::OpenClBackend backend(config);
+    backend.set_mesh(mesh);
+    std::size_t k = 0;
+    for (SdfDomain domain : {SdfDomain::Vertex, SdfDomain::Face}) {
+      const SdfQuery q = make_query(mesh, domain);
+      RawSdf got = backend.compute(q, SdfOptions{});
+      if (per_item == 1) {
+        std::size_t kept = 0;
+        for (std::uint32_t r : got.kept_rays) kept += r;
+        EXPECT_GT(kept, q.size() * 10) << "most rays of a torus hit its far wall";
+        first.push_back(std::move(got));
+        continue;
+      }
+      const RawSdf& want = first[k++];
+      ASSERT_EQ(got.values.size(), want.values.size());
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < got.values.size(); ++i)
+        differ += std::memcmp(&got.values[i], &want.values[i], sizeof(float)) != 0 ||
+                  got.kept_rays[i] != want.kept_rays[i];
+      EXPECT_EQ(differ, 0u) << per_item << " bundles per item, " << (domain == SdfDomain::Vertex ? "vertices" : "faces");
+    }
+  }
+}
+
+TEST(OpenClBundlesPerItem, RejectsACountTheKernelDoesNotHave) {
+  cl::OpenClConfig config;
+  config.bvh_bundles_per_item = 3;
+  EXPECT_THROW(cl::OpenClBackend{config}, InputError);
+}

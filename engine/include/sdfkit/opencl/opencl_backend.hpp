@@ -79,6 +79,11 @@ struct OpenClConfig {
   // driver's choice left a core idle at the end of small launches, and a bundle work item
   // traces several rays, so small groups balance the skeleton's small calls), the driver's on GPUs.
   std::size_t work_group_size = 0;
+  // Bundles a trace_bundles work item walks, their traversal steps alternated so that one
+  // bundle's next node loads while the others are tested (1, 2 or 4; 0 = 4 on CPU devices,
+  // measured in bench/RESULTS.md, 1 on GPUs). Every value gives the same result bit for bit:
+  // each bundle visits the same nodes in the same order.
+  std::size_t bvh_bundles_per_item = 0;
 };
 
 class OpenClBackend final : public SdfBackend {
