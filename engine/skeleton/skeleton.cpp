@@ -1270,9 +1270,35 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // gives the tip (that vertex's centre point); when the tip lies over a node radius beyond the
   // leaf and the segment to it is inside, a tip node takes the leaf's vertices that lie beyond
   // the midpoint and see it (the leaf keeps at least one).
+  //
+  // First, a leaf that lies along the edge its neighbour continues on is a point of that limb,
+  // not its end (s11leaves): the surgery can join a hip straight to the foot and leave the
+  // knee's node hanging off the foot. Where a curve leaf L hangs from a degree-2 curve node F
+  // whose other neighbour is H, L projects strictly between H and F, lies within the tube of
+  // HF (the ends' radii interpolated) and the segment HL is inside, the curve runs H-L-F and F,
+  // the farther node, becomes the leaf. Leaf count, junctions and cycles are unchanged.
   if (options.extend_leaves) {
     std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
     for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+    for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
+      if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet) continue;
+      const std::uint32_t f = adjacency[leaf].front();
+      if (adjacency[f].size() != 2 || sk.nodes[f].sheet) continue;
+      const std::uint32_t h = adjacency[f][0] == leaf ? adjacency[f][1] : adjacency[f][0];
+      if (sk.nodes[h].sheet) continue;
+      const glm::vec3 a = sk.nodes[h].position, b = sk.nodes[f].position, p = sk.nodes[leaf].position;
+      const float len2 = glm::dot(b - a, b - a);
+      if (!(len2 > 0.0f)) continue;
+      const float t = glm::dot(p - a, b - a) / len2;
+      if (!(t > 0.0f && t < 1.0f)) continue;
+      const float tube = (1.0f - t) * sk.nodes[h].radius + t * sk.nodes[f].radius;
+      if (glm::length(p - (a + t * (b - a))) >= tube || surface.bvh.segment_blocked(a, p)) continue;
+      edges.erase({std::min(h, f), std::max(h, f)});
+      add_edge(h, leaf);
+      adjacency[f] = {leaf};
+      adjacency[leaf] = {f, h};
+      std::replace(adjacency[h].begin(), adjacency[h].end(), f, leaf);
+    }
     const std::size_t count = sk.nodes.size();
     for (std::uint32_t leaf = 0; leaf < count; ++leaf) {
       if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) continue;

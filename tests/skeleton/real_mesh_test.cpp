@@ -176,6 +176,27 @@ TEST(SkeletonRealMeshes, CamelHasLeavesAtItsExtremities) {
   EXPECT_LT(nearest_leaf(mesh, s, extreme(mesh, {0, 0, -1})), 0.10) << "-z end";
 }
 
+// CGAL's homer (y up, feet at the bottom, legs straight): the surgery joins the pelvis straight
+// to a foot and leaves the knee's node hanging off the foot, so the branch ended at the knee,
+// 0.157 of the diagonal from the foot's lowest vertex, on both legs. A leaf that lies inside the
+// tube of the edge its neighbour continues on is threaded into that edge, and the branch ends at
+// the foot. On this mesh it holds on one leg; the other knee lies just outside the tube (RESULTS,
+// s11leaves).
+TEST(SkeletonRealMeshes, StraightLegEndsAtTheFootNotTheKnee) {
+  const Mesh mesh = load("homer.off");
+  const sk::Skeleton s = extract(mesh);
+  expect_valid(mesh, s, "homer.off");
+  const float cx = bounding_box(mesh.positions).center().x;
+  double best = 1e30;
+  for (const bool left : {true, false}) {
+    glm::vec3 foot{0.0f, 1e30f, 0.0f};
+    for (const glm::vec3& p : mesh.positions)
+      if ((p.x < cx) == left && p.y < foot.y) foot = p;
+    best = std::min(best, nearest_leaf(mesh, s, foot));
+  }
+  EXPECT_LT(best, 0.12) << "no leg's branch reaches its foot";
+}
+
 TEST(SkeletonRealMeshes, CowIsATreeInsideTheSolid) {
   const Mesh mesh = load("cow.off");
   const sk::Skeleton s = extract(mesh);

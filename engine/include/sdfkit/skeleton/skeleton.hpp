@@ -150,7 +150,9 @@ struct SkeletonOptions {
   bool refine_embedding = true;
   // Give each curve leaf a tip node at the centre point of its vertex farthest along the limb
   // (when that lies over a node radius beyond the leaf, inside the solid): leaves reach the
-  // ends of limbs instead of stopping at the centre of the last node's region.
+  // ends of limbs instead of stopping at the centre of the last node's region. Before that, a
+  // leaf hanging off a degree-2 node, inside the tube of the edge that node continues on (a knee
+  // hanging off the foot), is threaded into that edge, so the farther node becomes the leaf.
   bool extend_leaves = true;
   // Drop a terminal curve branch whose nodes' balls (centre, radius) all lie inside the ball of
   // the node it hangs from: it adds nothing to the solid the skeleton's balls describe (a bump
