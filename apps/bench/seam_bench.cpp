@@ -5,14 +5,23 @@
 //  - the seam ratio: P95 of |u_a - u_b| / |x_a - x_b| over edges whose ends are read back from
 //    different charts, over the same P95 for the edges inside charts (the issue's ≤ 1.5), and
 //    in brackets the same ratio of the heat-diffused field (what the field gives without seams);
-//  - against intrinsic heat diffusion (t = sigma² / 2, cotangent Laplacian, 8 implicit steps,
-//    the library's, through tests/diffusion/diffuse_test_util.hpp): Pearson, median
+//  - against intrinsic heat diffusion (t = sigma² / 2, cotangent Laplacian, lumped mass; N implicit
+//    steps (M + (t / N) L) u_{k+1} = M u_k, the library's diffusion::kHeatSteps = 8 as the tests,
+//    through tests/diffusion/diffuse_test_util.hpp; --heat-steps 1 is the single solve
+//    (M + t L) u = M u0): Pearson, median
 //    relative difference and RMS difference of the texture-space result, and the RMS of k-ring
 //    smoothing at the same sigma (kring_for_sigma); "tex/k" is the ratio of the two RMS (≤ 1: the
 //    texture space is no further from heat than k-ring).
 // The field: a smooth wave over the bounding box plus seeded noise (the camel test's field).
 // After the table, a summary per sigma over the meshes: the medians of the seam ratio and of
-// tex/k, and how many meshes meet seam ratio ≤ 1.5, tex/k ≤ 1 and Pearson ≥ 0.95.
+// tex/k, and how many meshes meet seam ratio ≤ 1.5, tex/k ≤ 1, Pearson ≥ 0.95 and median relative
+// difference ≤ 5 %.
+//
+// --heat-steps takes a list (default "8,1": the reference, then the single solve beside it;
+// e.g. 1,8,64): the rows and the seam ratio's bracket use the first;
+// the last column gives Pearson / median rel. / tex/k against each further one, and the summary
+// has one line per sigma and step count (the same texture-space and k-ring results, measured
+// against each reference).
 //
 // With the band, each vertex is read back from every chart covering it, blended (StmOptions::blend),
 // unless --no-blend. The blur's width follows the charts' local stretch (DiffuseOptions::stretch)
@@ -24,7 +33,7 @@
 // vertices' own charts, their share of the vertices, the RMS of texture space and of k-ring
 // against heat over them, and the kind's share of texture space's squared error.
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--no-band] [--no-blend] [--no-stretch] [--by-kind] [--atlas-size N] [--models] [MESH...]
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 8,1] [--no-band] [--no-blend] [--no-stretch] [--by-kind] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -64,6 +73,11 @@ int main(int argc, char** argv) {
   app.add_flag("--models", models, "Also generated shapes: capsule, torus, the skeleton models (star, genus 2, C and S plates)");
   std::string sigma_list = "1,2,3,5";
   app.add_option("--sigmas", sigma_list, "Sigmas in mean edge lengths, comma separated");
+  std::string steps_list = diffusion::kHeatSteps == 1 ? "1" : std::to_string(diffusion::kHeatSteps) + ",1";
+  app.add_option("--heat-steps", steps_list,
+                 "Implicit steps of the heat reference, comma separated; the first is the rows', the others are summarized beside it "
+                 "(default: the reference's steps, then the issue's single solve)")
+      ->capture_default_str();
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
   app.add_flag("--no-blend", no_blend, "Every vertex read back from its own chart only (no blend over the charts covering it)");
   app.add_flag("--no-stretch", no_stretch, "One blur width in texels per chart (its mean scale) instead of one per texel from the map's local stretch");
@@ -86,6 +100,19 @@ int main(int argc, char** argv) {
     sigmas.push_back(x);
     at = end + 1;
   }
+  std::vector<int> heat_steps;
+  for (std::size_t at = 0; at <= steps_list.size();) {
+    const std::size_t end = std::min(steps_list.find(',', at), steps_list.size());
+    const std::string item = steps_list.substr(at, end - at);
+    char* stop = nullptr;
+    const long n = std::strtol(item.c_str(), &stop, 10);
+    if (item.empty() || *stop != '\0' || n < 1 || n > 4096) {
+      std::fprintf(stderr, "error: --heat-steps: '%s' is not a whole number from 1 to 4096\n", item.c_str());
+      return 2;
+    }
+    heat_steps.push_back(static_cast<int>(n));
+    at = end + 1;
+  }
   try {
     vk::Context ctx{vk::ContextConfig{}};
     diffusion::Diffuser diffuser(ctx);
@@ -93,13 +120,18 @@ int main(int argc, char** argv) {
                 "Against heat diffusion: texture Pearson / median rel. / RMS; k-ring RMS; tex/k = RMS ratio.\n\n",
                 atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back",
                 no_stretch ? "one blur width per chart" : "stretch-compensated blur");
+    std::printf("Heat reference: %d implicit step%s of t / %d", heat_steps[0], heat_steps[0] == 1 ? "" : "s", heat_steps[0]);
+    if (heat_steps.size() > 1) std::printf(" (the last column: against %zu more)", heat_steps.size() - 1);
+    std::printf(".\n\n");
     std::printf("| mesh | vertices | sigma (edges) | charts | atlas triangles / faces | seam ratio (heat) | pearson | median rel | "
-                "rms | k-ring (k) rms | tex/k | tex/k per chart | overlap | build_stm s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    // Per sigma, over the meshes: seam ratio, tex/k, Pearson (the summary at the end).
+                "rms | k-ring (k) rms | tex/k | tex/k per chart | overlap | build_stm s | other steps: pearson / median rel / tex/k |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    // Per sigma and heat reference, over the meshes: seam ratio, tex/k, Pearson, median relative
+    // difference (the summary at the end).
     struct Summary {
-      std::vector<double> seam, texk, pearson, texk_per_chart;
+      std::vector<double> seam, texk, pearson, median_rel, texk_per_chart;
     };
-    std::vector<Summary> summary(sigmas.size());
+    std::vector<std::vector<Summary>> summary(sigmas.size(), std::vector<Summary>(heat_steps.size()));
     std::vector<std::pair<std::string, std::function<Mesh()>>> inputs;
     for (const std::string& path : meshes)
       inputs.emplace_back(std::filesystem::path(path).stem().string(), [path] { return io::load_asset(path).mesh; });
@@ -131,7 +163,9 @@ int main(int argc, char** argv) {
           o.stretch = !no_stretch;
           const std::vector<float> tex = diffuser.run(m, stm.mapping, u, o).values;
           const double ratio = diffusion::seam_ratio(m, stm.mapping, tex);
-          const std::vector<float> heat = test::heat_diffusion(m, u, sigma);
+          std::vector<std::vector<float>> heats;
+          for (const int steps : heat_steps) heats.push_back(test::heat_diffusion(m, u, sigma, steps));
+          const std::vector<float>& heat = heats[0];
           // The same statistic of the heat field over the same partition of the edges: what the
           // field and where the borders lie give without any seam.
           const double heat_ratio = diffusion::seam_ratio(m, stm.mapping, heat);
@@ -144,13 +178,28 @@ int main(int argc, char** argv) {
           // The same mapping with one blur width per chart (what the stretch compensation changes).
           diffusion::DiffuseOptions per_chart = o;
           per_chart.stretch = false;
-          const double rms1 = test::rms_difference(diffuser.run(m, stm.mapping, u, per_chart).values, heat);
-          std::printf("| %s | %zu | %g | %zu | %.2f | %.2f (%.2f) | %.4f | %.2f %% | %.4f | %.4f (%d) | %.2f | %.2f | %.2f %% | %.2f |\n", name.c_str(),
+          const std::vector<float> tex1 = diffuser.run(m, stm.mapping, u, per_chart).values;
+          const double rms1 = test::rms_difference(tex1, heat);
+          std::printf("| %s | %zu | %g | %zu | %.2f | %.2f (%.2f) | %.4f | %.2f %% | %.4f | %.4f (%d) | %.2f | %.2f | %.2f %% | %.2f | ", name.c_str(),
                       m.vertex_count(), static_cast<double>(edges), stm.mapping.charts.size(),
                       static_cast<double>(stm.mapping.triangles.size()) / static_cast<double>(m.triangles.size()), ratio, heat_ratio,
                       c.pearson, 100.0 * c.median_relative, rms, krms, ko.rings, krms > 0 ? rms / krms : 0.0,
                       krms > 0 ? rms1 / krms : 0.0, 100.0 * stm.quality.overlap, stm.quality.seconds);
-          summary[si].texk_per_chart.push_back(krms > 0 ? rms1 / krms : 0.0);
+          // Every reference (the first again, for the summary): the same results measured against it.
+          for (std::size_t hi = 0; hi < heat_steps.size(); ++hi) {
+            const FieldComparison ch = compare_fields(tex, heats[hi]);
+            const double rh = test::rms_difference(tex, heats[hi]), kh = test::rms_difference(kr, heats[hi]);
+            const double r1 = test::rms_difference(tex1, heats[hi]);
+            if (hi > 0)
+              std::printf("%d: %.4f / %.2f %% / %.2f; ", heat_steps[hi], ch.pearson, 100.0 * ch.median_relative, kh > 0 ? rh / kh : 0.0);
+            Summary& su = summary[si][hi];
+            su.seam.push_back(ratio);
+            su.texk.push_back(kh > 0 ? rh / kh : 0.0);
+            su.pearson.push_back(ch.pearson);
+            su.median_rel.push_back(ch.median_relative);
+            su.texk_per_chart.push_back(kh > 0 ? r1 / kh : 0.0);
+          }
+          std::printf("|\n");
           if (by_kind) {
             // Squared errors of texture space and k-ring against heat, summed per kind of the
             // vertex's own chart.
@@ -175,9 +224,6 @@ int main(int argc, char** argv) {
             }
             std::printf("|\n");
           }
-          summary[si].seam.push_back(ratio);
-          summary[si].texk.push_back(krms > 0 ? rms / krms : 0.0);
-          summary[si].pearson.push_back(c.pearson);
           std::fflush(stdout);
         }
       } catch (const Error& e) {
@@ -185,22 +231,24 @@ int main(int argc, char** argv) {
       }
     }
     // The summary: medians and counts against the targets (seam ratio ≤ 1.5, tex/k ≤ 1,
-    // Pearson ≥ 0.95).
+    // Pearson ≥ 0.95, median relative difference ≤ 5 %), per sigma and heat reference.
     const auto median = [](std::vector<double> v) { return diffusion::quantile(std::move(v), 0.5); };
     const auto count = [](const std::vector<double>& v, auto pred) {
       std::size_t n = 0;
       for (double x : v) n += pred(x) ? 1 : 0;
       return n;
     };
-    std::printf("\n| sigma (edges) | meshes | seam ratio median | seam ratio <= 1.5 | tex/k median | tex/k <= 1 | pearson >= 0.95 | "
-                "tex/k per chart median | tex/k per chart <= 1 |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (std::size_t si = 0; si < sigmas.size(); ++si) {
-      const Summary& u = summary[si];
-      std::printf("| %g | %zu | %.2f | %zu | %.2f | %zu | %zu | %.2f | %zu |\n", static_cast<double>(sigmas[si]), u.seam.size(), median(u.seam),
-                  count(u.seam, [](double x) { return x <= 1.5; }), median(u.texk), count(u.texk, [](double x) { return x <= 1.0; }),
-                  count(u.pearson, [](double x) { return x >= 0.95; }), median(u.texk_per_chart),
-                  count(u.texk_per_chart, [](double x) { return x <= 1.0; }));
-    }
+    std::printf("\n| sigma (edges) | heat steps | meshes | seam ratio median | seam ratio <= 1.5 | tex/k median | tex/k <= 1 | pearson >= 0.95 | "
+                "median rel <= 5 %% | tex/k per chart median | tex/k per chart <= 1 |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (std::size_t si = 0; si < sigmas.size(); ++si)
+      for (std::size_t hi = 0; hi < heat_steps.size(); ++hi) {
+        const Summary& u = summary[si][hi];
+        std::printf("| %g | %d | %zu | %.2f | %zu | %.2f | %zu | %zu | %zu | %.2f | %zu |\n", static_cast<double>(sigmas[si]), heat_steps[hi],
+                    u.seam.size(), median(u.seam), count(u.seam, [](double x) { return x <= 1.5; }), median(u.texk),
+                    count(u.texk, [](double x) { return x <= 1.0; }), count(u.pearson, [](double x) { return x >= 0.95; }),
+                    count(u.median_rel, [](double x) { return x <= 0.05; }), median(u.texk_per_chart),
+                    count(u.texk_per_chart, [](double x) { return x <= 1.0; }));
+      }
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

@@ -106,7 +106,8 @@ void add_compare_command(CLI::App& app) {
       ->check(CLI::Range(16, 16384));
   cmd->add_option("--skeleton", d->skeleton, "--diffusion: skeleton JSON of the mesh (default: extracted)");
   cmd->add_option("--device", d->device, "--diffusion: Vulkan device (index or name)");
-  cmd->add_option("--heat-steps", d->heat_steps, "--diffusion: implicit steps of the heat reference (default 8)")
+  cmd->add_option("--heat-steps", d->heat_steps, "--diffusion: implicit steps of the heat reference")
+      ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--json", d->json, "--diffusion: also write the table as JSON");
   cmd->add_option("--mesh", a->mesh, "The mesh the .txt values belong to");

@@ -4,6 +4,7 @@
 // how far the two are from heat diffusion (Pearson, median relative difference, RMS), as a table
 // and JSON. cmd_compare.cpp parses the options; this file does the work.
 
+#include "sdfkit/diffusion/heat.hpp"
 #include "sdfkit/io/asset.hpp"
 
 #include <cstdint>
@@ -19,7 +20,7 @@ struct DiffusionCompareArgs {
   std::vector<double> sigma_edges;  // in mean edge lengths (one of the two lists, not both)
   std::uint32_t atlas_size = 2048;  // texture space
   std::string skeleton, device;     // texture space: skeleton JSON (default: extracted), Vulkan device
-  int heat_steps = 8;               // implicit steps of the heat reference
+  int heat_steps = diffusion::kHeatSteps;  // implicit steps of the heat reference
   std::string json;                 // also write the rows as JSON here
   io::LoadOptions load;
 };

@@ -22,8 +22,9 @@
 namespace sdfkit::test {
 
 // Heat flow for time t = sigma² / 2: the library's reference (sdfkit/diffusion/heat.hpp, `steps`
-// implicit steps with the cotangent Laplacian and the lumped mass).
-inline std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> u0, double sigma, int steps = 8) {
+// implicit steps with the cotangent Laplacian and the lumped mass). The one reference of the
+// tests and of sdfkit-seam-bench: diffusion::kHeatSteps steps unless a test asks for others.
+inline std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> u0, double sigma, int steps = diffusion::kHeatSteps) {
   return diffusion::heat_diffusion(mesh, u0, sigma, steps);
 }
 

@@ -14,8 +14,13 @@
 
 namespace sdfkit::diffusion {
 
+// The reference's step count: the one definition that the tests, sdfkit-seam-bench and
+// `sdfkit compare --diffusion` use by default (bench/RESULTS.md, "Heat reference: one solve
+// against several steps").
+inline constexpr int kHeatSteps = 8;
+
 // One finite value per vertex, sigma > 0, steps >= 1; throws InputError otherwise. Degenerate
 // (zero-area) triangles are skipped; a vertex that no triangle with area touches keeps its value.
-std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> values, double sigma, int steps = 8);
+std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> values, double sigma, int steps = kHeatSteps);
 
 }  // namespace sdfkit::diffusion
