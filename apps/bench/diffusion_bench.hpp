@@ -1,8 +1,9 @@
 #pragma once
 // `sdfkit bench --diffusion`: the paper's Table 2 on this machine. On each mesh: the skeleton
 // texture mapping (build_stm, timed), then texture-space diffusion at radius 2, 4, 8, 16, 32, 64
-// texels on the atlas (rasterization, blur, read-back and total, device times from the graph's
-// timestamps), next to k-ring smoothing with k = 1..6 on the same mesh.
+// texels on the atlas (rasterization, blur, read-back and total: wall and CPU time of the graph
+// with and without the blur passes, alternated; lavapipe's timestamps do not time a dispatch),
+// next to k-ring smoothing with k = 1..6 on the same mesh.
 
 #include "bench_runner.hpp"
 
