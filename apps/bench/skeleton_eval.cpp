@@ -76,6 +76,20 @@ struct CgalResult {
 };
 
 // CGAL's contract_until_convergence(), spelled out so the iterations can be counted.
+// CGAL's skeleton graph's leaves (degree-1 points) and independent cycles (E - V + components).
+void count_leaves_and_cycles(CgalResult& r) {
+  std::vector<int> degree(r.graph.points.size(), 0);
+  for (const auto& e : r.graph.edges) ++degree[e[0]], ++degree[e[1]];
+  for (std::uint32_t v = 0; v < degree.size(); ++v)
+    if (degree[v] == 1) r.graph.leaves.push_back(v);
+  sdfkit::UnionFind uf(r.graph.points.size());
+  std::size_t components = r.graph.points.size();
+  for (const auto& e : r.graph.edges)
+    if (uf.unite(e[0], e[1])) --components;
+  r.cycles = static_cast<int>(r.graph.edges.size()) - static_cast<int>(r.graph.points.size()) +
+             static_cast<int>(components);
+}
+
 CgalResult run_cgal(const sdfkit::Mesh& mesh) {
   CgalResult r;
   try {
@@ -112,20 +126,9 @@ CgalResult run_cgal(const sdfkit::Mesh& mesh) {
       const auto& p = skeleton[v].point;
       r.graph.points.emplace_back(p.x(), p.y(), p.z());
     }
-    std::vector<int> degree(r.graph.points.size(), 0);
-    for (auto e : CGAL::make_range(edges(skeleton))) {
-      const std::uint32_t a = index[source(e, skeleton)], b = index[target(e, skeleton)];
-      r.graph.edges.push_back({a, b});
-      ++degree[a], ++degree[b];
-    }
-    for (std::uint32_t v = 0; v < degree.size(); ++v)
-      if (degree[v] == 1) r.graph.leaves.push_back(v);
-    sdfkit::UnionFind uf(r.graph.points.size());
-    std::size_t components = r.graph.points.size();
-    for (const auto& e : r.graph.edges)
-      if (uf.unite(e[0], e[1])) --components;
-    r.cycles = static_cast<int>(r.graph.edges.size()) - static_cast<int>(r.graph.points.size()) +
-               static_cast<int>(components);
+    for (auto e : CGAL::make_range(edges(skeleton)))
+      r.graph.edges.push_back({index[source(e, skeleton)], index[target(e, skeleton)]});
+    count_leaves_and_cycles(r);
     r.ok = true;
   } catch (const std::exception& e) {
     r.error = e.what();
@@ -157,16 +160,7 @@ CgalResult read_cgal(const std::string& path) {
       r.graph.edges.push_back({a - 1, b - 1});
     }
   }
-  std::vector<int> degree(r.graph.points.size(), 0);
-  for (const auto& e : r.graph.edges) ++degree[e[0]], ++degree[e[1]];
-  for (std::uint32_t v = 0; v < degree.size(); ++v)
-    if (degree[v] == 1) r.graph.leaves.push_back(v);
-  sdfkit::UnionFind uf(r.graph.points.size());
-  std::size_t components = r.graph.points.size();
-  for (const auto& e : r.graph.edges)
-    if (uf.unite(e[0], e[1])) --components;
-  r.cycles = static_cast<int>(r.graph.edges.size()) - static_cast<int>(r.graph.points.size()) +
-             static_cast<int>(components);
+  count_leaves_and_cycles(r);
   r.seconds = -1.0;
   r.ok = true;
   return r;
