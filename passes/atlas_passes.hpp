@@ -56,8 +56,7 @@ struct SampleRange {
 static_assert(sizeof(SampleRange) == 16);
 
 struct RasterPush {  // atlas_raster.vert, atlas_raster.frag
-  glm::vec4 scale;   // x: 2 / atlas size, y: the stretch-compensated blur's variance where the mesh's triangles are
-                     // of its mean size (model units², for reference: the fragment stage reads RasterVertex::variance)
+  glm::vec4 scale;   // x: 2 / atlas size (the blur's variance per triangle is RasterVertex::variance)
 };
 struct BlurPush {    // atlas_blur.comp, atlas_blur_box.comp
   std::uint32_t job_offset, job_count, size, axis, box, src_tiled;
@@ -81,8 +80,8 @@ struct DilatePush {  // atlas_dilate.comp
 
 // Rasterizes `vertex_count` RasterVertex corners into `target` (RG32F, cleared to 0: value,
 // coverage) and, when `stretch_target` is valid, into it (RG32F, cleared to -1: the
-// stretch-compensated blur's box half-widths along x and y for `variance`, from the covering
-// triangle's stretch; glsl/atlas_common.glsl stretch_half_width), and copies them into `texels`
+// stretch-compensated blur's box half-widths along x and y for each triangle's
+// RasterVertex::variance, from its stretch; glsl/atlas_common.glsl stretch_half_width), and copies them into `texels`
 // and `stretch` (size² vec2, row-major). `pipeline` has two colour attachments then
 // (atlas_raster.frag), else one (atlas_raster_value.frag) and `stretch` is neither written nor
 // returned (a blur with one width in texels never reads it). Returns the written buffers.
@@ -91,7 +90,6 @@ struct AtlasRasterPass {
   vk::ImageHandle target, stretch_target;
   vk::BufferHandle vertices, charts, texels, stretch;
   std::uint32_t vertex_count = 0, size = 0;
-  float variance = 0.0f;  // model units², as AtlasBlurPass::variance
 };
 struct AtlasRasterOutput {
   vk::BufferHandle texels, stretch;

@@ -27,7 +27,7 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
     const VkBuffer b = pc.buffer(in.vertices);
     const VkDeviceSize offset = 0;
     vkCmdBindVertexBuffers(pc.cmd, 0, 1, &b, &offset);
-    const RasterPush push{glm::vec4(2.0f / static_cast<float>(in.size), in.variance, 0.0f, 0.0f)};
+    const RasterPush push{glm::vec4(2.0f / static_cast<float>(in.size), 0.0f, 0.0f, 0.0f)};
     vkCmdPushConstants(pc.cmd, in.pipeline->layout.get(), kStages, 0, sizeof(push), &push);
     vkCmdDraw(pc.cmd, in.vertex_count, 1, 0, 0);
   });

@@ -455,7 +455,6 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   rp.stretch = stretch;
   const float variance =
       options.sigma > 0.0f ? static_cast<float>(std::max(static_cast<double>(options.sigma) * options.sigma - interp_variance, 0.0)) : 0.0f;
-  rp.variance = variance;
   rp.vertex_count = static_cast<std::uint32_t>(soup.size());
   rp.size = size;
   const auto rastered = passes::add_atlas_raster_pass(graph, rp);
