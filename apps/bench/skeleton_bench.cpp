@@ -33,6 +33,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -172,6 +173,12 @@ int main(int argc, char** argv) {
     } else {
       paths.push_back(arg);
     }
+  }
+  // A directory of CGAL skeletons that is not there would turn every mesh's row into an error.
+  if (!eval.cgal_dir.empty() && !std::filesystem::is_directory(eval.cgal_dir)) {
+    std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-from %s: no such directory (write one with --dump)\n",
+                 eval.cgal_dir.c_str());
+    return 2;
   }
   if (paths.empty())
     for (const char* m : {"elephant.off", "refined_elephant.off", "camel.off", "hand.off"})
