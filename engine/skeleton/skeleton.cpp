@@ -1449,9 +1449,12 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // (radius interpolated along the edge), the union the pruning of terminal branches asks about.
   // A vertex whose centre point lies outside that union lies on a part of the solid that the
   // skeleton does not reach. A connected region of such vertices is a protrusion when
-  //   - it reaches farther from the centre of its base (the vertices just outside the region)
-  //     than the base's own radius: a bump on its base reaches at most a hemisphere, a band
-  //     along a flattened body or a plate's rim is as wide along its boundary as it is long;
+  //   - it reaches farther from its base (the vertices just outside the region: the distance
+  //     from its farthest vertex to the nearest base vertex) than the base's own radius (from
+  //     the base's centroid): a bump on its base reaches at most a hemisphere, a band along a
+  //     flattened body or a plate's rim is as wide along its boundary as it is far from it.
+  //     Measured from the base's centroid instead, the end band of a thin-walled pipe passed
+  //     (its base circles the axis and the centroid lies on the axis);
   //   - the ball of the region (mean centre point, mean vertex radius |u - centre| = SDF/2)
   //     does not touch the union either (a band beside a spine has its mean near the spine);
   //   - its base has no sheet vertex (a region beside a sheet continues that plate: the C plate).
@@ -1603,9 +1606,9 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         for (std::uint32_t k : region) mean += glm::dvec3(surface.centre[k]), r += vertex_radius[k];
         const double count = static_cast<double>(region.size());
         if (touches(glm::vec3(mean / count), static_cast<float>(r / count), UINT32_MAX)) continue;
-        // A limb reaches farther from where it leaves the rest of the surface than that base is
-        // wide; a bump on a base of width w reaches w / 2 (a hemisphere), and a band along a
-        // flattened body or a plate's rim is as wide (along its boundary) as it is long.
+        // A limb reaches farther from where it leaves the rest of the surface (its base) than
+        // the base's radius; a bump reaches at most a hemisphere, and a band along a flattened
+        // body or a plate's rim is as wide along its base as it is far from it.
         // A region that borders a sheet continues the plate that the sheet describes (the C
         // plate's ends), not a limb.
         glm::dvec3 base(0.0);
@@ -1622,10 +1625,16 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
           }
         if (boundary.empty() || borders_sheet) continue;
         base /= static_cast<double>(boundary.size());
-        double width = 0.0, reach = 0.0;
-        for (std::uint32_t w : boundary) width = std::max(width, glm::length(glm::dvec3(original.positions[w]) - base));
-        for (std::uint32_t k : region) reach = std::max(reach, glm::length(glm::dvec3(original.positions[k]) - base));
-        if (!(reach > width)) continue;
+        double base_radius = 0.0, reach = 0.0;
+        for (std::uint32_t w : boundary)
+          base_radius = std::max(base_radius, glm::length(glm::dvec3(original.positions[w]) - base));
+        for (std::uint32_t k : region) {
+          double nearest = std::numeric_limits<double>::infinity();
+          for (std::uint32_t w : boundary)
+            nearest = std::min(nearest, glm::length(glm::dvec3(original.positions[k]) - glm::dvec3(original.positions[w])));
+          reach = std::max(reach, nearest);
+        }
+        if (!(reach > base_radius)) continue;
         if (add_leaf(region)) {
           any = true;
           continue;
