@@ -463,6 +463,128 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // that point (a non-convex cross-section: the C and S plates) or no node is seen from it.
   // Up to three rounds: what the first node leaves unseen (a long limb's tip) may get the next.
   std::vector<std::uint8_t> region_is_sheet(n, 0);
+  // A new curve node at the mean of `part`'s centre points for the vertices of `part` that
+  // see it, joined to the nearest curve node it sees; false when under half of them see it or
+  // no node is seen from it.
+  auto add_node = [&](const std::vector<std::uint32_t>& part) {
+    glm::dvec3 mean(0.0);
+    for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
+    glm::vec3 p(mean / static_cast<double>(part.size()));
+    if (!surface.bvh.inside(p)) {
+      // The nearest centre point inside the solid (a centre point can be outside where no
+      // inside point was found for its vertex: thin wings and fins); none of the 16 nearest:
+      // no node.
+      std::vector<std::pair<float, std::uint32_t>> by_distance;
+      for (std::uint32_t k : part) by_distance.push_back({glm::length(surface.centre[k] - p), k});
+      const std::size_t tried = std::min<std::size_t>(by_distance.size(), 16);
+      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
+                        by_distance.end());
+      bool found = false;
+      for (std::size_t i = 0; i < tried && !found; ++i)
+        if (surface.bvh.inside(surface.centre[by_distance[i].second]))
+          p = surface.centre[by_distance[i].second], found = true;
+      if (!found) return false;
+    }
+    std::vector<std::uint32_t> seeing;
+    for (std::uint32_t k : part)
+      if (surface.sees(k, p)) seeing.push_back(k);
+    if (2 * seeing.size() < part.size()) return false;
+    std::vector<std::pair<float, std::uint32_t>> by_distance;
+    for (std::uint32_t c = 0; c < curve_nodes; ++c) by_distance.push_back({glm::length(position[c] - p), c});
+    const std::size_t tried = std::min<std::size_t>(by_distance.size(), 64);
+    std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
+                      by_distance.end());
+    std::uint32_t attach = UINT32_MAX;
+    for (std::size_t i = 0; i < tried; ++i)
+      if (!surface.bvh.segment_blocked(p, position[by_distance[i].second])) {
+        attach = by_distance[i].second;
+        break;
+      }
+    if (attach == UINT32_MAX) return false;
+    const auto c = static_cast<std::uint32_t>(curve_nodes++);
+    position.push_back(p);
+    members.emplace_back();
+    graph.members.emplace_back();
+    graph.positions.push_back(p);
+    graph_adjacency.emplace_back();
+    graph.edges.push_back({std::min(attach, c), std::max(attach, c)});
+    graph_adjacency[attach].push_back(c);
+    graph_adjacency[c].push_back(attach);
+    for (std::uint32_t k : seeing) choice[k] = c;
+    return true;
+  };
+  // `region` split into pieces of connected vertices whose centre points share a cell of
+  // kRegionCell * diag (in the order of their first vertex), and whether it is mostly flat:
+  // pieces of >= 4 vertices whose centre points spread in two directions (lambda_2 / lambda_1 >
+  // kFlatRatio) hold over half of those pieces' vertices.
+  struct Pieces {
+    std::vector<std::vector<std::uint32_t>> pieces;
+    bool mostly_flat = false;
+  };
+  auto split_region = [&](const std::vector<std::uint32_t>& region) {
+    const double cell = kRegionCell * diag;
+    std::map<std::array<std::int64_t, 3>, std::uint32_t> cell_index;
+    std::vector<std::uint32_t> cell_of(region.size());
+    std::map<std::uint32_t, std::uint32_t> slot;  // vertex -> index in region
+    for (std::uint32_t i = 0; i < region.size(); ++i) {
+      const glm::vec3 q = surface.centre[region[i]];
+      const std::array<std::int64_t, 3> key{static_cast<std::int64_t>(std::floor(q.x / cell)),
+                                            static_cast<std::int64_t>(std::floor(q.y / cell)),
+                                            static_cast<std::int64_t>(std::floor(q.z / cell))};
+      cell_of[i] = cell_index.try_emplace(key, static_cast<std::uint32_t>(cell_index.size())).first->second;
+      slot[region[i]] = i;
+    }
+    UnionFind pieces(region.size());
+    for (const Triangle& t : original.triangles)
+      for (int e = 0; e < 3; ++e) {
+        const auto a = slot.find(t[e]), b = slot.find(t[(e + 1) % 3]);
+        if (a != slot.end() && b != slot.end() && cell_of[a->second] == cell_of[b->second])
+          pieces.unite(a->second, b->second);
+      }
+    std::map<std::uint32_t, std::vector<std::uint32_t>> piece_members;
+    std::vector<std::uint32_t> piece_order;
+    for (std::uint32_t i = 0; i < region.size(); ++i) {
+      auto [it, inserted] = piece_members.try_emplace(pieces.find(i));
+      if (inserted) piece_order.push_back(pieces.find(i));
+      it->second.push_back(region[i]);
+    }
+    double flat = 0.0, total = 0.0;
+    for (std::uint32_t r : piece_order) {
+      const std::vector<std::uint32_t>& piece = piece_members[r];
+      if (piece.size() < 4) continue;
+      glm::dvec3 m(0.0);
+      for (std::uint32_t k : piece) m += glm::dvec3(surface.centre[k]);
+      m /= static_cast<double>(piece.size());
+      glm::dmat3 cov(0.0);
+      for (std::uint32_t k : piece) {
+        const glm::dvec3 d = glm::dvec3(surface.centre[k]) - m;
+        cov += glm::outerProduct(d, d);
+      }
+      // Eigenvalues of the symmetric 3x3 covariance (trigonometric solution).
+      const double l2 = second_eigenvalue_ratio(cov);
+      total += static_cast<double>(piece.size());
+      if (l2 > kFlatRatio) flat += static_cast<double>(piece.size());
+    }
+    Pieces out;
+    for (std::uint32_t r : piece_order) out.pieces.push_back(std::move(piece_members[r]));
+    out.mostly_flat = total > 0.0 && flat > 0.5 * total;
+    return out;
+  };
+  // A node for each piece (add_node), the pieces nearest to the existing skeleton first, so a
+  // missed limb becomes a chain of nodes; true when any was added.
+  auto add_piece_nodes = [&](const Pieces& split) {
+    std::vector<std::pair<float, std::uint32_t>> order;
+    for (std::uint32_t i = 0; i < split.pieces.size(); ++i) {
+      float best = std::numeric_limits<float>::max();
+      for (std::uint32_t c = 0; c < curve_nodes; ++c)
+        best = std::min(best, glm::length(position[c] - surface.centre[split.pieces[i].front()]));
+      order.push_back({best, i});
+    }
+    std::sort(order.begin(), order.end());
+    bool added = false;
+    for (const auto& [d, i] : order) added |= add_node(split.pieces[i]);
+    return added;
+  };
   for (int round = 0; round < 3; ++round) {
     UnionFind regions(n);
     bool any = false;
@@ -479,56 +601,6 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         if (inserted) region_order.push_back(regions.find(k));
         it->second.push_back(k);
       }
-    // A new curve node at the mean of `part`'s centre points for the vertices of `part` that
-    // see it, joined to the nearest curve node it sees; false when under half of them see it or
-    // no node is seen from it.
-    auto add_node = [&](const std::vector<std::uint32_t>& part) {
-      glm::dvec3 mean(0.0);
-      for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
-      glm::vec3 p(mean / static_cast<double>(part.size()));
-      if (!surface.bvh.inside(p)) {
-        // The nearest centre point inside the solid (a centre point can be outside where no
-        // inside point was found for its vertex: thin wings and fins); none of the 16 nearest:
-        // no node.
-        std::vector<std::pair<float, std::uint32_t>> by_distance;
-        for (std::uint32_t k : part) by_distance.push_back({glm::length(surface.centre[k] - p), k});
-        const std::size_t tried = std::min<std::size_t>(by_distance.size(), 16);
-        std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
-                          by_distance.end());
-        bool found = false;
-        for (std::size_t i = 0; i < tried && !found; ++i)
-          if (surface.bvh.inside(surface.centre[by_distance[i].second]))
-            p = surface.centre[by_distance[i].second], found = true;
-        if (!found) return false;
-      }
-      std::vector<std::uint32_t> seeing;
-      for (std::uint32_t k : part)
-        if (surface.sees(k, p)) seeing.push_back(k);
-      if (2 * seeing.size() < part.size()) return false;
-      std::vector<std::pair<float, std::uint32_t>> by_distance;
-      for (std::uint32_t c = 0; c < curve_nodes; ++c) by_distance.push_back({glm::length(position[c] - p), c});
-      const std::size_t tried = std::min<std::size_t>(by_distance.size(), 64);
-      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
-                        by_distance.end());
-      std::uint32_t attach = UINT32_MAX;
-      for (std::size_t i = 0; i < tried; ++i)
-        if (!surface.bvh.segment_blocked(p, position[by_distance[i].second])) {
-          attach = by_distance[i].second;
-          break;
-        }
-      if (attach == UINT32_MAX) return false;
-      const auto c = static_cast<std::uint32_t>(curve_nodes++);
-      position.push_back(p);
-      members.emplace_back();
-      graph.members.emplace_back();
-      graph.positions.push_back(p);
-      graph_adjacency.emplace_back();
-      graph.edges.push_back({std::min(attach, c), std::max(attach, c)});
-      graph_adjacency[attach].push_back(c);
-      graph_adjacency[c].push_back(attach);
-      for (std::uint32_t k : seeing) choice[k] = c;
-      return true;
-    };
     for (std::uint32_t root : region_order) {
       const std::vector<std::uint32_t>& region = region_members[root];
       if (add_node(region)) {
@@ -541,63 +613,12 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       // spread is small), across a plate with a non-convex cross-section they fill the cell.
       // A region whose pieces are mostly flat is a sheet; otherwise each piece gets a node,
       // nearest to the existing skeleton first, so a missed limb becomes a chain of nodes.
-      const double cell = kRegionCell * diag;
-      std::map<std::array<std::int64_t, 3>, std::uint32_t> cell_index;
-      std::vector<std::uint32_t> cell_of(region.size());
-      std::map<std::uint32_t, std::uint32_t> slot;  // vertex -> index in region
-      for (std::uint32_t i = 0; i < region.size(); ++i) {
-        const glm::vec3 q = surface.centre[region[i]];
-        const std::array<std::int64_t, 3> key{static_cast<std::int64_t>(std::floor(q.x / cell)),
-                                              static_cast<std::int64_t>(std::floor(q.y / cell)),
-                                              static_cast<std::int64_t>(std::floor(q.z / cell))};
-        cell_of[i] = cell_index.try_emplace(key, static_cast<std::uint32_t>(cell_index.size())).first->second;
-        slot[region[i]] = i;
-      }
-      UnionFind pieces(region.size());
-      for (const Triangle& t : original.triangles)
-        for (int e = 0; e < 3; ++e) {
-          const auto a = slot.find(t[e]), b = slot.find(t[(e + 1) % 3]);
-          if (a != slot.end() && b != slot.end() && cell_of[a->second] == cell_of[b->second])
-            pieces.unite(a->second, b->second);
-        }
-      std::map<std::uint32_t, std::vector<std::uint32_t>> piece_members;
-      std::vector<std::uint32_t> piece_order;
-      for (std::uint32_t i = 0; i < region.size(); ++i) {
-        auto [it, inserted] = piece_members.try_emplace(pieces.find(i));
-        if (inserted) piece_order.push_back(pieces.find(i));
-        it->second.push_back(region[i]);
-      }
-      double flat = 0.0, total = 0.0;
-      for (std::uint32_t r : piece_order) {
-        const std::vector<std::uint32_t>& piece = piece_members[r];
-        if (piece.size() < 4) continue;
-        glm::dvec3 m(0.0);
-        for (std::uint32_t k : piece) m += glm::dvec3(surface.centre[k]);
-        m /= static_cast<double>(piece.size());
-        glm::dmat3 cov(0.0);
-        for (std::uint32_t k : piece) {
-          const glm::dvec3 d = glm::dvec3(surface.centre[k]) - m;
-          cov += glm::outerProduct(d, d);
-        }
-        // Eigenvalues of the symmetric 3x3 covariance (trigonometric solution).
-        const double l2 = second_eigenvalue_ratio(cov);
-        total += static_cast<double>(piece.size());
-        if (l2 > kFlatRatio) flat += static_cast<double>(piece.size());
-      }
-      if (total > 0.0 && flat > 0.5 * total &&
-          static_cast<double>(region.size()) >= kSheetRegionShare * static_cast<double>(n)) {
+      const Pieces split = split_region(region);
+      if (split.mostly_flat && static_cast<double>(region.size()) >= kSheetRegionShare * static_cast<double>(n)) {
         for (std::uint32_t k : region) region_is_sheet[k] = 1;
         continue;
       }
-      std::vector<std::pair<float, std::uint32_t>> order;
-      for (std::uint32_t r : piece_order) {
-        float best = std::numeric_limits<float>::max();
-        for (std::uint32_t c = 0; c < curve_nodes; ++c)
-          best = std::min(best, glm::length(position[c] - surface.centre[piece_members[r].front()]));
-        order.push_back({best, r});
-      }
-      std::sort(order.begin(), order.end());
-      for (const auto& [d, r] : order) any |= add_node(piece_members[r]);
+      any |= add_piece_nodes(split);
     }
     if (!any) break;
   }
@@ -1265,6 +1286,37 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         if (v != UINT32_MAX) v = index[v];
     }
   }
+  // The tip node of a curve leaf (see below); nothing when `leaf` is not a curve leaf of
+  // `adjacency` with at least two vertices.
+  auto extend_tip = [&](std::uint32_t leaf, const std::vector<std::vector<std::uint32_t>>& adjacency) {
+    if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) return;
+    const glm::vec3 p = sk.nodes[leaf].position, q = sk.nodes[adjacency[leaf].front()].position;
+    const float len = glm::length(p - q);
+    if (!(len > 0.0f)) return;
+    const glm::vec3 dir = (p - q) / len;
+    std::uint32_t far_vertex = sk.nodes[leaf].vertices.front();
+    for (std::uint32_t k : sk.nodes[leaf].vertices)
+      if (glm::dot(original.positions[k] - p, dir) > glm::dot(original.positions[far_vertex] - p, dir)) far_vertex = k;
+    const glm::vec3 tip = surface.centre[far_vertex];
+    if (glm::dot(tip - p, dir) <= sk.nodes[leaf].radius || !surface.bvh.inside(tip) ||
+        surface.bvh.segment_blocked(p, tip))
+      return;
+    const glm::vec3 mid = 0.5f * (p + tip);
+    std::vector<std::uint32_t> moved, kept;
+    for (std::uint32_t k : sk.nodes[leaf].vertices)
+      (glm::dot(original.positions[k] - mid, dir) > 0.0f && surface.sees(k, tip) ? moved : kept).push_back(k);
+    if (moved.empty() || kept.empty()) return;
+    sk.nodes[leaf].vertices = std::move(kept);
+    sk.nodes[leaf].radius = surface.radius(p, sk.nodes[leaf].vertices);
+    Node node;
+    node.position = tip;
+    node.vertices = std::move(moved);
+    node.radius = surface.radius(tip, node.vertices);
+    const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+    for (std::uint32_t k : node.vertices) node_of_vertex[k] = id;
+    sk.nodes.push_back(std::move(node));
+    add_edge(leaf, id);
+  };
   // Leaves reach the end of their limb: a curve leaf's node sits at the centre of its vertices'
   // region, short of the limb's tip. Its vertex farthest along the direction from its neighbour
   // gives the tip (that vertex's centre point); when the tip lies over a node radius beyond the
@@ -1300,35 +1352,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       std::replace(adjacency[h].begin(), adjacency[h].end(), f, leaf);
     }
     const std::size_t count = sk.nodes.size();
-    for (std::uint32_t leaf = 0; leaf < count; ++leaf) {
-      if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) continue;
-      const glm::vec3 p = sk.nodes[leaf].position, q = sk.nodes[adjacency[leaf].front()].position;
-      const float len = glm::length(p - q);
-      if (!(len > 0.0f)) continue;
-      const glm::vec3 dir = (p - q) / len;
-      std::uint32_t far_vertex = sk.nodes[leaf].vertices.front();
-      for (std::uint32_t k : sk.nodes[leaf].vertices)
-        if (glm::dot(original.positions[k] - p, dir) > glm::dot(original.positions[far_vertex] - p, dir)) far_vertex = k;
-      const glm::vec3 tip = surface.centre[far_vertex];
-      if (glm::dot(tip - p, dir) <= sk.nodes[leaf].radius || !surface.bvh.inside(tip) ||
-          surface.bvh.segment_blocked(p, tip))
-        continue;
-      const glm::vec3 mid = 0.5f * (p + tip);
-      std::vector<std::uint32_t> moved, kept;
-      for (std::uint32_t k : sk.nodes[leaf].vertices)
-        (glm::dot(original.positions[k] - mid, dir) > 0.0f && surface.sees(k, tip) ? moved : kept).push_back(k);
-      if (moved.empty() || kept.empty()) continue;
-      sk.nodes[leaf].vertices = std::move(kept);
-      sk.nodes[leaf].radius = surface.radius(p, sk.nodes[leaf].vertices);
-      Node node;
-      node.position = tip;
-      node.vertices = std::move(moved);
-      node.radius = surface.radius(tip, node.vertices);
-      const auto id = static_cast<std::uint32_t>(sk.nodes.size());
-      for (std::uint32_t k : node.vertices) node_of_vertex[k] = id;
-      sk.nodes.push_back(std::move(node));
-      add_edge(leaf, id);
-    }
+    for (std::uint32_t leaf = 0; leaf < count; ++leaf) extend_tip(leaf, adjacency);
   }
   // Curve edges follow the limb between their nodes (s11shape). Grouping leaves nodes up to the
   // grouping distance apart (a bear: 8 nodes), and a straight edge between two of them is a chord
@@ -1345,77 +1369,301 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // is left as it was. a and b keep their positions and at least one vertex each. Each vertex
   // moves at most once; a chain has the edge's ends, so leaves, junctions and cycles are
   // unchanged.
-  if (options.section_nodes) {
-    std::vector<std::uint8_t> moved(n, 0);
-    const std::vector<std::array<std::uint32_t, 2>> current(edges.begin(), edges.end());
+  std::vector<std::uint8_t> moved(n, 0);
+  auto add_sections = [&](const std::vector<std::array<std::uint32_t, 2>>& current) {
     for (const auto& e : current) {
-      const std::uint32_t a = e[0], b = e[1];
-      if (sk.nodes[a].sheet || sk.nodes[b].sheet) continue;
-      const glm::vec3 pa = sk.nodes[a].position, pb = sk.nodes[b].position;
-      const float len = glm::length(pb - pa);
-      const float r = 0.5f * (sk.nodes[a].radius + sk.nodes[b].radius);
-      if (!(r > 0.0f) || !(len > 2.0f * r)) continue;
-      const glm::vec3 dir = (pb - pa) / len;
-      const int sections = static_cast<int>(std::lround(len / r));
-      const float spacing = len / static_cast<float>(sections);
-      std::vector<std::vector<std::uint32_t>> slice(static_cast<std::size_t>(sections));
-      std::size_t left_a = sk.nodes[a].vertices.size(), left_b = sk.nodes[b].vertices.size();
-      for (const std::uint32_t end : {a, b})
-        for (std::uint32_t k : sk.nodes[end].vertices) {
-          if (moved[k]) continue;
-          const float t = glm::dot(original.positions[k] - pa, dir);
-          const int j = static_cast<int>(std::lround(t / spacing));
-          if (j < 1 || j >= sections) continue;
-          const glm::vec3 c = surface.centre[k];
-          const float tc = std::clamp(glm::dot(c - pa, dir), 0.0f, len);
-          if (glm::length(c - (pa + tc * dir)) > r) continue;
-          slice[static_cast<std::size_t>(j)].push_back(k);
+    const std::uint32_t a = e[0], b = e[1];
+    if (sk.nodes[a].sheet || sk.nodes[b].sheet) continue;
+    const glm::vec3 pa = sk.nodes[a].position, pb = sk.nodes[b].position;
+    const float len = glm::length(pb - pa);
+    const float r = 0.5f * (sk.nodes[a].radius + sk.nodes[b].radius);
+    if (!(r > 0.0f) || !(len > 2.0f * r)) continue;
+    const glm::vec3 dir = (pb - pa) / len;
+    const int sections = static_cast<int>(std::lround(len / r));
+    const float spacing = len / static_cast<float>(sections);
+    std::vector<std::vector<std::uint32_t>> slice(static_cast<std::size_t>(sections));
+    std::size_t left_a = sk.nodes[a].vertices.size(), left_b = sk.nodes[b].vertices.size();
+    for (const std::uint32_t end : {a, b})
+      for (std::uint32_t k : sk.nodes[end].vertices) {
+        if (moved[k]) continue;
+        const float t = glm::dot(original.positions[k] - pa, dir);
+        const int j = static_cast<int>(std::lround(t / spacing));
+        if (j < 1 || j >= sections) continue;
+        const glm::vec3 c = surface.centre[k];
+        const float tc = std::clamp(glm::dot(c - pa, dir), 0.0f, len);
+        if (glm::length(c - (pa + tc * dir)) > r) continue;
+        slice[static_cast<std::size_t>(j)].push_back(k);
+      }
+    std::vector<std::pair<glm::vec3, std::vector<std::uint32_t>>> chain;
+    for (const auto& part : slice) {
+      if (part.size() < 3) continue;
+      glm::dvec3 mean(0.0);
+      for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
+      const glm::vec3 at(mean / static_cast<double>(part.size()));
+      if (!surface.bvh.inside(at)) continue;
+      std::vector<std::uint32_t> seeing;
+      for (std::uint32_t k : part)
+        if (surface.sees(k, at)) seeing.push_back(k);
+      if (seeing.size() < 3) continue;
+      chain.push_back({at, std::move(seeing)});
+    }
+    if (chain.empty()) continue;
+    for (const auto& [at, part] : chain)
+      for (std::uint32_t k : part) (node_of_vertex[k] == a ? left_a : left_b)--;
+    bool ok = left_a > 0 && left_b > 0;
+    glm::vec3 previous = pa;
+    for (const auto& [at, part] : chain) {
+      ok = ok && !surface.bvh.segment_blocked(previous, at);
+      previous = at;
+    }
+    ok = ok && !surface.bvh.segment_blocked(previous, pb);
+    if (!ok) continue;
+    std::set<std::uint32_t> leaving;
+    for (const auto& [at, part] : chain) leaving.insert(part.begin(), part.end());
+    for (const std::uint32_t end : {a, b}) {
+      std::vector<std::uint32_t>& v = sk.nodes[end].vertices;
+      v.erase(std::remove_if(v.begin(), v.end(), [&](std::uint32_t k) { return leaving.count(k) > 0; }), v.end());
+      sk.nodes[end].radius = surface.radius(sk.nodes[end].position, v);
+    }
+    edges.erase(e);
+    std::uint32_t from = a;
+    for (auto& [at, part] : chain) {
+      Node node;
+      node.position = at;
+      node.radius = surface.radius(at, part);
+      const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+      for (std::uint32_t k : part) node_of_vertex[k] = id, moved[k] = 1;
+      node.vertices = std::move(part);
+      sk.nodes.push_back(std::move(node));
+      add_edge(from, id);
+      from = id;
+    }
+    add_edge(from, b);
+    }
+  };
+  if (options.section_nodes) add_sections(std::vector<std::array<std::uint32_t, 2>>(edges.begin(), edges.end()));
+  // Protrusions that the contraction merged whole (s11branch): a thin part (an ear, a foot, a
+  // tusk) that contracted into a node of the body and whose vertices see that node, so the
+  // regions above (vertices that see no curve node) never gave it a branch. The skeleton stands
+  // for the union of its curve nodes' balls (position, radius) swept along its curve edges
+  // (radius interpolated along the edge), the union the pruning of terminal branches asks about.
+  // A vertex whose centre point lies outside that union lies on a part of the solid that the
+  // skeleton does not reach. A connected region of such vertices is a protrusion when
+  //   - it reaches farther from its base (the vertices just outside the region: the distance
+  //     from its farthest vertex to the nearest base vertex) than the base's own radius (from
+  //     the base's centroid): a bump on its base reaches at most a hemisphere, a band along a
+  //     flattened body or a plate's rim is as wide along its boundary as it is far from it.
+  //     Measured from the base's centroid instead, the end band of a thin-walled pipe passed
+  //     (its base circles the axis and the centroid lies on the axis);
+  //   - the ball of the region (mean centre point, mean vertex radius |u - centre| = SDF/2)
+  //     does not touch the union either (a band beside a spine has its mean near the spine);
+  //   - its base has no sheet vertex (a region beside a sheet continues that plate: the C plate).
+  // It gets curve nodes by the rules of the unseen regions: one node at the mean of its centre
+  // points when at least half of its vertices see it, joined to the nearest curve node it sees
+  // through the solid; else one per piece unless the pieces are mostly flat. A vertex moves to
+  // the new node when it sees it and its node keeps another vertex; a region that gets no node
+  // stays as it is. Up to three rounds (the union grows with the new nodes); then the new leaves
+  // get their tip nodes as above. Every new node is inside and every new edge is a segment
+  // inside from a new leaf to the skeleton, so cycles and sheets are unchanged. This runs after
+  // the cross-section nodes, so a branch joins the curve near where the protrusion leaves it (a
+  // heel joins the ankle's section, not the foot's leaf, which homer's foot lost otherwise),
+  // and the new edges get their own cross-sections. No new constant.
+  if (options.protrusion_branches) {
+    const std::size_t first_new = sk.nodes.size();
+    // Mesh neighbours of each vertex (CSR).
+    std::vector<std::uint32_t> ring_start(n + 1, 0), ring;
+    {
+      std::vector<std::array<std::uint32_t, 2>> pairs;
+      for (const Triangle& t : original.triangles)
+        for (int i = 0; i < 3; ++i) pairs.push_back({t[i], t[(i + 1) % 3]}), pairs.push_back({t[(i + 1) % 3], t[i]});
+      std::sort(pairs.begin(), pairs.end());
+      pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+      for (const auto& pr : pairs) ++ring_start[pr[0] + 1];
+      for (std::size_t k = 0; k < n; ++k) ring_start[k + 1] += ring_start[k];
+      ring.reserve(pairs.size());
+      for (const auto& pr : pairs) ring.push_back(pr[1]);
+    }
+    std::vector<float> vertex_radius(n);
+    for (std::uint32_t k = 0; k < n; ++k)
+      vertex_radius[k] = glm::length(original.positions[k] - surface.centre[k]);
+    for (int round = 0; round < 3; ++round) {
+      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+      std::vector<std::array<std::uint32_t, 2>> curve_edges;
+      for (const auto& e : edges) {
+        adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+        if (!sk.nodes[e[0]].sheet && !sk.nodes[e[1]].sheet) curve_edges.push_back(e);
+      }
+      auto touches_edge = [&](const glm::vec3& p, float r, std::uint32_t a, std::uint32_t b) {
+        const Node& na = sk.nodes[a];
+        const Node& nb = sk.nodes[b];
+        const glm::vec3 ab = nb.position - na.position;
+        const float len2 = glm::dot(ab, ab);
+        const float t = len2 > 0.0f ? std::clamp(glm::dot(p - na.position, ab) / len2, 0.0f, 1.0f) : 0.0f;
+        return glm::length(p - (na.position + t * ab)) <= na.radius + t * (nb.radius - na.radius) + r;
+      };
+      // Does the ball (p, r) touch the skeleton's union? `hint`'s node and edges first.
+      auto touches = [&](const glm::vec3& p, float r, std::uint32_t hint) {
+        if (hint != UINT32_MAX) {
+          if (glm::length(p - sk.nodes[hint].position) <= sk.nodes[hint].radius + r) return true;
+          for (std::uint32_t d : adjacency[hint])
+            if (!sk.nodes[d].sheet && touches_edge(p, r, hint, d)) return true;
         }
-      std::vector<std::pair<glm::vec3, std::vector<std::uint32_t>>> chain;
-      for (const auto& part : slice) {
-        if (part.size() < 3) continue;
+        for (const Node& node : sk.nodes)
+          if (!node.sheet && glm::length(p - node.position) <= node.radius + r) return true;
+        for (const auto& e : curve_edges)
+          if (touches_edge(p, r, e[0], e[1])) return true;
+        return false;
+      };
+      std::vector<std::uint32_t> stamp(n, 0);  // boundary vertices seen, per region (root + 1)
+      std::vector<std::uint8_t> outside(n, 0);
+      parallel_for(n, [&](std::size_t begin, std::size_t end) {
+        for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
+          const std::uint32_t c = node_of_vertex[k];
+          outside[k] = c != UINT32_MAX && !sk.nodes[c].sheet && !touches(surface.centre[k], 0.0f, c);
+        }
+      });
+      UnionFind regions(n);
+      for (const Triangle& t : original.triangles)
+        for (int i = 0; i < 3; ++i) {
+          const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+          if (outside[a] && outside[b]) regions.unite(a, b);
+        }
+      std::map<std::uint32_t, std::vector<std::uint32_t>> region_members;  // root -> vertices (ascending)
+      std::vector<std::uint32_t> region_order;
+      for (std::uint32_t k = 0; k < n; ++k)
+        if (outside[k]) {
+          auto [it, inserted] = region_members.try_emplace(regions.find(k));
+          if (inserted) region_order.push_back(regions.find(k));
+          it->second.push_back(k);
+        }
+      // A new curve leaf for `part` (the region step's add_node on the skeleton's nodes).
+      auto add_leaf = [&](const std::vector<std::uint32_t>& part) {
         glm::dvec3 mean(0.0);
         for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
-        const glm::vec3 at(mean / static_cast<double>(part.size()));
-        if (!surface.bvh.inside(at)) continue;
+        glm::vec3 p(mean / static_cast<double>(part.size()));
+        if (!surface.bvh.inside(p)) {
+          std::vector<std::pair<float, std::uint32_t>> by_distance;
+          for (std::uint32_t k : part) by_distance.push_back({glm::length(surface.centre[k] - p), k});
+          const std::size_t tried = std::min<std::size_t>(by_distance.size(), 16);
+          std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
+                            by_distance.end());
+          bool found = false;
+          for (std::size_t i = 0; i < tried && !found; ++i)
+            if (surface.bvh.inside(surface.centre[by_distance[i].second]))
+              p = surface.centre[by_distance[i].second], found = true;
+          if (!found) return false;
+        }
         std::vector<std::uint32_t> seeing;
         for (std::uint32_t k : part)
-          if (surface.sees(k, at)) seeing.push_back(k);
-        if (seeing.size() < 3) continue;
-        chain.push_back({at, std::move(seeing)});
-      }
-      if (chain.empty()) continue;
-      for (const auto& [at, part] : chain)
-        for (std::uint32_t k : part) (node_of_vertex[k] == a ? left_a : left_b)--;
-      bool ok = left_a > 0 && left_b > 0;
-      glm::vec3 previous = pa;
-      for (const auto& [at, part] : chain) {
-        ok = ok && !surface.bvh.segment_blocked(previous, at);
-        previous = at;
-      }
-      ok = ok && !surface.bvh.segment_blocked(previous, pb);
-      if (!ok) continue;
-      std::set<std::uint32_t> leaving;
-      for (const auto& [at, part] : chain) leaving.insert(part.begin(), part.end());
-      for (const std::uint32_t end : {a, b}) {
-        std::vector<std::uint32_t>& v = sk.nodes[end].vertices;
-        v.erase(std::remove_if(v.begin(), v.end(), [&](std::uint32_t k) { return leaving.count(k) > 0; }), v.end());
-        sk.nodes[end].radius = surface.radius(sk.nodes[end].position, v);
-      }
-      edges.erase(e);
-      std::uint32_t from = a;
-      for (auto& [at, part] : chain) {
-        Node node;
-        node.position = at;
-        node.radius = surface.radius(at, part);
+          if (surface.sees(k, p)) seeing.push_back(k);
+        if (seeing.empty() || 2 * seeing.size() < part.size()) return false;
+        std::vector<std::pair<float, std::uint32_t>> by_distance;
+        for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
+          if (!sk.nodes[c].sheet) by_distance.push_back({glm::length(sk.nodes[c].position - p), c});
+        const std::size_t tried = std::min<std::size_t>(by_distance.size(), 64);
+        std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
+                          by_distance.end());
+        std::uint32_t attach = UINT32_MAX;
+        for (std::size_t i = 0; i < tried; ++i)
+          if (!surface.bvh.segment_blocked(p, sk.nodes[by_distance[i].second].position)) {
+            attach = by_distance[i].second;
+            break;
+          }
+        if (attach == UINT32_MAX) return false;
+        // Each node keeps a vertex: where all of a node's vertices would move, the one nearest
+        // to it stays.
+        std::map<std::uint32_t, std::size_t> leaving;
+        for (std::uint32_t k : seeing) ++leaving[node_of_vertex[k]];
+        for (const auto& [c, count] : leaving) {
+          if (count < sk.nodes[c].vertices.size()) continue;
+          std::uint32_t stay = sk.nodes[c].vertices.front();
+          for (std::uint32_t k : sk.nodes[c].vertices)
+            if (glm::length(original.positions[k] - sk.nodes[c].position) <
+                glm::length(original.positions[stay] - sk.nodes[c].position))
+              stay = k;
+          std::erase(seeing, stay);
+        }
+        if (seeing.empty()) return false;
         const auto id = static_cast<std::uint32_t>(sk.nodes.size());
-        for (std::uint32_t k : part) node_of_vertex[k] = id, moved[k] = 1;
-        node.vertices = std::move(part);
+        for (const auto& [c, count] : leaving)
+          std::erase_if(sk.nodes[c].vertices, [&](std::uint32_t k) {
+            return std::binary_search(seeing.begin(), seeing.end(), k);
+          });
+        for (std::uint32_t k : seeing) node_of_vertex[k] = id;
+        Node node;
+        node.position = p;
+        node.radius = surface.radius(p, seeing);
+        node.vertices = std::move(seeing);
         sk.nodes.push_back(std::move(node));
-        add_edge(from, id);
-        from = id;
+        add_edge(attach, id);
+        return true;
+      };
+      bool any = false;
+      for (std::uint32_t root : region_order) {
+        const std::vector<std::uint32_t>& region = region_members[root];
+        glm::dvec3 mean(0.0);
+        double r = 0.0;
+        for (std::uint32_t k : region) mean += glm::dvec3(surface.centre[k]), r += vertex_radius[k];
+        const double count = static_cast<double>(region.size());
+        if (touches(glm::vec3(mean / count), static_cast<float>(r / count), UINT32_MAX)) continue;
+        // A limb reaches farther from where it leaves the rest of the surface (its base) than
+        // the base's radius; a bump reaches at most a hemisphere, and a band along a flattened
+        // body or a plate's rim is as wide along its base as it is far from it.
+        // A region that borders a sheet continues the plate that the sheet describes (the C
+        // plate's ends), not a limb.
+        glm::dvec3 base(0.0);
+        std::vector<std::uint32_t> boundary;
+        bool borders_sheet = false;
+        for (std::uint32_t k : region)
+          for (std::uint32_t i = ring_start[k]; i < ring_start[k + 1]; ++i) {
+            const std::uint32_t w = ring[i];
+            if (outside[w] || stamp[w] == root + 1) continue;
+            stamp[w] = root + 1;
+            boundary.push_back(w);
+            base += glm::dvec3(original.positions[w]);
+            borders_sheet = borders_sheet || node_of_vertex[w] == UINT32_MAX || sk.nodes[node_of_vertex[w]].sheet;
+          }
+        if (boundary.empty() || borders_sheet) continue;
+        base /= static_cast<double>(boundary.size());
+        double base_radius = 0.0, reach = 0.0;
+        for (std::uint32_t w : boundary)
+          base_radius = std::max(base_radius, glm::length(glm::dvec3(original.positions[w]) - base));
+        for (std::uint32_t k : region) {
+          double nearest = std::numeric_limits<double>::infinity();
+          for (std::uint32_t w : boundary)
+            nearest = std::min(nearest, glm::length(glm::dvec3(original.positions[k]) - glm::dvec3(original.positions[w])));
+          reach = std::max(reach, nearest);
+        }
+        if (!(reach > base_radius)) continue;
+        if (add_leaf(region)) {
+          any = true;
+          continue;
+        }
+        const Pieces split = split_region(region);
+        if (split.mostly_flat) continue;
+        std::vector<std::pair<float, std::uint32_t>> order;
+        for (std::uint32_t i = 0; i < split.pieces.size(); ++i) {
+          float best = std::numeric_limits<float>::max();
+          for (const Node& node : sk.nodes)
+            if (!node.sheet) best = std::min(best, glm::length(node.position - surface.centre[split.pieces[i].front()]));
+          order.push_back({best, i});
+        }
+        std::sort(order.begin(), order.end());
+        for (const auto& [d, i] : order) any |= add_leaf(split.pieces[i]);
       }
-      add_edge(from, b);
+      if (!any) break;
+    }
+    if (options.extend_leaves && sk.nodes.size() > first_new) {
+      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+      for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+      const std::size_t count = sk.nodes.size();
+      for (auto leaf = static_cast<std::uint32_t>(first_new); leaf < count; ++leaf) extend_tip(leaf, adjacency);
+    }
+    if (options.section_nodes) {
+      std::vector<std::array<std::uint32_t, 2>> added;
+      for (const auto& e : edges)
+        if (e[1] >= first_new) added.push_back(e);
+      add_sections(added);
     }
   }
   // Sheet-triangle edges are part of the sheet, not curve edges.

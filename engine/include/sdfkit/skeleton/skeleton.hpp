@@ -162,6 +162,13 @@ struct SkeletonOptions {
   // with a node at the centre of each (the mean of its vertices' centre points), so the curve
   // follows a bending limb instead of a chord between grouped nodes.
   bool section_nodes = true;
+  // Give a branch to a protrusion that the contraction merged whole into a node of the body (an
+  // ear, a foot): a connected region of vertices whose centre points lie outside the skeleton's
+  // union of node balls swept along its curve edges, that reaches farther from its base (the
+  // vertices around it) than the base's radius, whose mean ball is outside the union too and
+  // that borders no sheet, gets nodes by the rules of the unseen regions (one node seen by half
+  // of them, else one per piece unless mostly flat) and a leaf at its tip.
+  bool protrusion_branches = true;
 };
 
 struct Node {
