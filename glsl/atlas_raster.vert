@@ -1,11 +1,15 @@
 #version 450
 // Atlas raster, vertex stage: an atlas triangle's corner (texel coordinates) to clip space over
-// the whole atlas; texel (x, y) covers [x, x+1) x [y, y+1), framebuffer row y = atlas row y.
+// the whole atlas, with its mesh vertex's current value; texel (x, y) covers [x, x+1) x [y, y+1),
+// framebuffer row y = atlas row y.
 layout(location = 0) in vec2 in_uv;
-layout(location = 1) in float in_value;
+layout(location = 1) in uint in_vertex;  // the mesh vertex whose value the corner carries
 layout(location = 2) in uint in_chart;
 layout(location = 3) in vec2 in_stretch;  // model units per texel along x, y (the triangle's)
 layout(location = 4) in float in_variance;  // the blur's variance left over the triangle, model units²
+
+// One value per mesh vertex: the field, or the previous step's read-back (DiffuseOptions::steps).
+layout(std430, binding = 1) readonly buffer Values { float values[]; };
 
 layout(push_constant) uniform Push {
   vec4 scale;  // x: 2 / atlas size
@@ -18,7 +22,7 @@ layout(location = 3) flat out float out_variance;
 
 void main() {
   gl_Position = vec4(in_uv * pc.scale.x - 1.0, 0.0, 1.0);
-  out_value = in_value;
+  out_value = values[in_vertex];
   out_chart = in_chart;
   out_stretch = in_stretch;
   out_variance = in_variance;

@@ -3,7 +3,8 @@
 // inside a chart: clamped to the rectangle, wrapping in x for cylindrical charts), each read
 // normalized by the blurred coverage: sum(w · value·coverage) / sum(w · coverage); the reads
 // blended by the queries' weights (a partition of unity over the charts covering the vertex,
-// AtlasMapping::samples). A vertex no covered texel reaches keeps its fallback (its own value).
+// AtlasMapping::samples), written over the vertex's value: one that no covered texel reaches keeps
+// the value it had (the field's, or the previous step's).
 #extension GL_GOOGLE_include_directive : require
 #include "atlas_common.glsl"
 
@@ -17,15 +18,14 @@ struct Query {
 struct Range {
   uint first;
   uint count;
-  float fallback;
-  uint pad;
 };
 
 layout(std430, binding = 0) readonly buffer Charts { Chart charts[]; };
 layout(std430, binding = 1) readonly buffer Texels { vec2 texels[]; };  // tiled (atlas_common.glsl)
 layout(std430, binding = 2) readonly buffer Queries { Query queries[]; };
 layout(std430, binding = 3) readonly buffer Ranges { Range ranges[]; };
-layout(std430, binding = 4) writeonly buffer Values { float values[]; };
+// In: each vertex's current value (what it keeps where nothing reaches its queries); out: the read.
+layout(std430, binding = 4) buffer Values { float values[]; };
 
 layout(push_constant) uniform Push {
   uint vertex_count;
@@ -68,5 +68,5 @@ void main() {
     sum += q.weight * v.x * v.y;
     weight += q.weight * v.y;
   }
-  values[i] = weight > 0.0 ? sum / weight : r.fallback;
+  if (weight > 0.0) values[i] = sum / weight;
 }

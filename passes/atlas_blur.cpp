@@ -13,7 +13,7 @@
 
 namespace sdfkit::diffusion::passes {
 
-vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& in) {
+AtlasBlurOutput add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& in) {
   vk::BufferHandle prefix = in.prefix;
   // One dispatch: `count` jobs from `offset`, reading src, writing a new version of dst. `keep`:
   // dst holds another dispatch's charts that are still needed (a partial write, declared as
@@ -83,7 +83,7 @@ vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPa
     offset += cascade;
     std::swap(a, b);  // the next axis reads what this one ended in
   }
-  return a;
+  return {a, b, prefix};
 }
 
 }  // namespace sdfkit::diffusion::passes

@@ -29,7 +29,7 @@ static_assert(sizeof(GpuChart) == 48);
 // One corner of a rasterized atlas triangle (atlas_raster.vert's vertex input).
 struct RasterVertex {
   glm::vec2 uv;        // atlas texels
-  float value;
+  std::uint32_t vertex;  // the mesh vertex whose value the corner carries (AtlasRasterPass::values)
   std::uint32_t chart; // fragments outside this chart's rectangle are discarded
   glm::vec2 stretch;   // the triangle's |dX/du|, |dX/dv|: model units per texel along the atlas's x and y
   // The Gaussian's variance per axis left for the stretch-compensated blur over this triangle,
@@ -50,10 +50,8 @@ static_assert(sizeof(SampleQuery) == 16);
 // A vertex's reads: queries [first, first + count), blended by weight.
 struct SampleRange {
   std::uint32_t first, count;
-  float fallback;      // returned when no covered texel reaches any of them
-  std::uint32_t pad;
 };
-static_assert(sizeof(SampleRange) == 16);
+static_assert(sizeof(SampleRange) == 8);
 
 struct RasterPush {  // atlas_raster.vert, atlas_raster.frag
   glm::vec4 scale;   // x: 2 / atlas size (the blur's variance per triangle is RasterVertex::variance)
@@ -78,21 +76,25 @@ struct DilatePush {  // atlas_dilate.comp
   std::uint32_t chart, size, reach, margin;
 };
 
-// Rasterizes `vertex_count` RasterVertex corners into `target` (RG32F, cleared to 0: value,
-// coverage) and, when `stretch_target` is valid, into it (RG32F, cleared to -1: the
-// stretch-compensated blur's box half-widths along x and y for each triangle's
-// RasterVertex::variance, from its stretch; glsl/atlas_common.glsl stretch_half_width), and copies them into `texels`
-// and `stretch` (size² vec2, row-major). `pipeline` has two colour attachments then
+// Rasterizes `vertex_count` RasterVertex corners, each carrying the value of its mesh vertex in
+// `values` (one float per mesh vertex), into `target` (RG32F, cleared to 0: value, coverage) and,
+// when `stretch_target` is valid, into it (RG32F, cleared to -1: the stretch-compensated blur's
+// box half-widths along x and y for each triangle's RasterVertex::variance, from its stretch;
+// glsl/atlas_common.glsl stretch_half_width), and copies them into `texels` and `stretch` (size²
+// vec2, row-major). `pipeline` has two colour attachments then
 // (atlas_raster.frag), else one (atlas_raster_value.frag) and `stretch` is neither written nor
 // returned (a blur with one width in texels never reads it). Returns the written buffers.
 struct AtlasRasterPass {
   const vk::Pipeline* pipeline = nullptr;
   vk::ImageHandle target, stretch_target;
-  vk::BufferHandle vertices, charts, texels, stretch;
+  vk::BufferHandle vertices, values, charts, texels, stretch;
   std::uint32_t vertex_count = 0, size = 0;
 };
+// The versions the pass wrote: the buffers, and the render targets (which a later step's raster
+// pass clears and draws again).
 struct AtlasRasterOutput {
   vk::BufferHandle texels, stretch;
+  vk::ImageHandle target, stretch_target;
 };
 AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRasterPass& pass);
 
@@ -105,7 +107,8 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
 // chart, line) lie in this order: fused rows, cascade rows, fused columns, cascade columns. Both
 // ways end each axis in the same buffer, so an axis is a fused dispatch and three cascade
 // dispatches over disjoint charts, each left out when it has no line. Returns the blurred, tiled
-// texel buffer (a version of `texels`).
+// texel buffer (a version of `texels`) and the versions of `scratch` and `prefix` it left (what a
+// later step's blur writes again).
 //
 // Stretch-compensated (`stretch_pipeline` set, glsl/atlas_blur_stretch.comp, every line in the
 // cascade, no fused lines): each box's width is chosen per output texel from the raster pass's
@@ -121,7 +124,10 @@ struct AtlasBlurPass {
   std::uint32_t rows_fused = 0, rows_cascade = 0, columns_fused = 0, columns_cascade = 0, size = 0;
   float variance = 0.0f;
 };
-vk::BufferHandle add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& pass);
+struct AtlasBlurOutput {
+  vk::BufferHandle texels, scratch, prefix;
+};
+AtlasBlurOutput add_atlas_blur_passes(vk::RenderGraph& graph, const AtlasBlurPass& pass);
 // The largest box radius the fused shader's rings hold (glsl/atlas_blur.comp kRing = 256 >=
 // 2 · 127 + 1).
 inline constexpr std::uint32_t kFusedMaxRadius = 127;
@@ -129,7 +135,9 @@ inline constexpr std::uint32_t kFusedMaxRadius = 127;
 inline constexpr std::uint32_t kShortLine = 256;
 
 // Per vertex: the weighted mean of the normalized bilinear reads of the blurred texels at its
-// queries (`ranges`: one SampleRange per vertex). Returns the written `values`.
+// queries (`ranges`: one SampleRange per vertex), written over its value in `values` (which it
+// keeps where no covered texel reaches any of its queries). Returns the new version of `values`,
+// which the next step's raster pass can read (DiffuseOptions::steps).
 struct AtlasSamplePass {
   const vk::Pipeline* pipeline = nullptr;
   vk::BufferHandle texels, charts, queries, ranges, values;

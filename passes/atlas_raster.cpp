@@ -1,9 +1,10 @@
-// Atlas raster pass: the mapping's triangles, one value per corner, into an RG32F atlas
-// (value, coverage) cleared to zero and, when the blur is stretch-compensated, an RG32F target of
-// its box half-widths along x and y (from the triangle's model units per texel; cleared to -1:
-// none) (glsl/atlas_raster*), then copied into the buffers the blur works on. Without a stretch
-// target the pass has one colour attachment (the atlas_raster_value.frag pipeline). Fragments
-// outside their triangle's chart rectangle are discarded in the shader.
+// Atlas raster pass: the mapping's triangles, each corner with its mesh vertex's value (read from
+// the values buffer by vertex index), into an RG32F atlas (value, coverage) cleared to zero and,
+// when the blur is stretch-compensated, an RG32F target of its box half-widths along x and y
+// (from the triangle's model units per texel; cleared to -1: none) (glsl/atlas_raster*), then
+// copied into the buffers the blur works on. Without a stretch target the pass has one colour
+// attachment (the atlas_raster_value.frag pipeline). Fragments outside their triangle's chart
+// rectangle are discarded in the shader.
 #include "atlas_passes.hpp"
 
 namespace sdfkit::diffusion::passes {
@@ -18,11 +19,12 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
       with_stretch ? raster.color(in.stretch_target, vk::LoadOp::Clear, VkClearColorValue{{-1.0f, -1.0f, 0.0f, 0.0f}})
                    : vk::ImageHandle{};
   raster.vertex(in.vertices);
+  raster.storage_read(in.values);
   raster.storage_read(in.charts);
   raster.execute([in](vk::PassContext& pc) {
     if (in.vertex_count == 0) return;
     vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, in.pipeline->get());
-    const VkDescriptorSet set = pc.descriptor_set(in.pipeline->set_layout.get(), {{0, in.charts}});
+    const VkDescriptorSet set = pc.descriptor_set(in.pipeline->set_layout.get(), {{0, in.charts}, {1, in.values}});
     vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, in.pipeline->layout.get(), 0, 1, &set, 0, nullptr);
     const VkBuffer b = pc.buffer(in.vertices);
     const VkDeviceSize offset = 0;
@@ -46,6 +48,8 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
     return out;
   };
   AtlasRasterOutput out;
+  out.target = target;
+  out.stretch_target = stretch_target;
   out.texels = copy_out("atlas.raster.copy", target, in.texels);
   if (with_stretch) out.stretch = copy_out("atlas.raster.stretch_copy", stretch_target, in.stretch);
   return out;

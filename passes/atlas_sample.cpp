@@ -11,7 +11,7 @@ vk::BufferHandle add_atlas_sample_pass(vk::RenderGraph& graph, const AtlasSample
   p.storage_read(in.charts);
   p.storage_read(in.queries);
   p.storage_read(in.ranges);
-  const vk::BufferHandle values = p.storage_write(in.values);
+  const vk::BufferHandle values = p.storage_read_write(in.values);  // a vertex nothing reaches keeps its value
   p.side_effect();  // the host reads the values
   p.execute([in, values](vk::PassContext& pc) {
     if (in.vertex_count == 0) return;

@@ -72,6 +72,7 @@ void add_smooth_command(CLI::App& app) {
     SmoothOptions smooth;
     bool texture = false;
     float radius = 0.0f;
+    std::uint32_t steps = 0;
     std::uint32_t atlas_size = 2048;
     std::string atlas_png, skeleton, device;
     io::LoadOptions load;
@@ -91,6 +92,11 @@ void add_smooth_command(CLI::App& app) {
                 "Diffuse through a skeleton texture mapping on a Vulkan device instead (needs --radius or --sigma)");
   cmd->add_option("--radius", a->radius, "--texture-space: the Gaussian's sigma in atlas texels, every chart")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--steps", a->steps,
+                  "--texture-space: the blur as N successive blurs of width / sqrt(N), each from the values the "
+                  "last read back, so the kernel carries on across chart borders (0 = as many as the mapping's "
+                  "reach needs, 1 = one blur, the paper's)")
+      ->check(CLI::Range(0u, diffusion::kMaxSteps));
   cmd->add_option("--atlas-size", a->atlas_size, "--texture-space: atlas side in texels (default 2048)")
       ->check(CLI::Range(16, 16384));
   cmd->add_option("--atlas-png", a->atlas_png, "--texture-space: also write the diffused field in the atlas as PNG");
@@ -115,7 +121,7 @@ void add_smooth_command(CLI::App& app) {
         throw UsageError("--texture-space needs exactly one of --radius (texels) and --sigma (model units)");
       if (!a->atlas_png.empty()) check_png_name(a->atlas_png);
     } else {
-      for (const char* k : {"--radius", "--atlas-size", "--atlas-png", "--skeleton", "--device"})
+      for (const char* k : {"--radius", "--steps", "--atlas-size", "--atlas-png", "--skeleton", "--device"})
         if (given(k)) throw UsageError(std::string(k) + " needs --texture-space");
     }
     const ResultValues r = load_or_compute(a->input, nullptr, a->load);
@@ -126,6 +132,7 @@ void add_smooth_command(CLI::App& app) {
       diffusion::TextureSmoothOptions t;
       t.diffuse.radius_px = a->radius;
       t.diffuse.sigma = a->radius > 0.0f ? 0.0f : a->smooth.sigma;
+      t.diffuse.steps = a->steps;
       t.stm.atlas_size = a->atlas_size;
       t.device = a->device;
       skeleton::Skeleton skel;
@@ -160,9 +167,10 @@ void add_smooth_command(CLI::App& app) {
       else std::snprintf(scale, sizeof scale, "sigma %g", static_cast<double>(a->smooth.sigma));
       if (!a->quiet)
         std::printf("%s: %zu vertex values diffused in texture space (%zu charts on a %u² atlas, %s) in %.1f ms "
-                    "(skeleton %.2f s, mapping %.2f s, diffusion %.1f ms) -> %s%s%s\n",
+                    "(skeleton %.2f s, mapping %.2f s, diffusion %.1f ms in %u step%s) -> %s%s%s\n",
                     a->input.c_str(), field.values.size(), d.stm.mapping.charts.size(), d.stm.mapping.size,
-                    scale, ms, d.skeleton_seconds, d.mapping_seconds, d.diffusion.timings.total, a->output.c_str(),
+                    scale, ms, d.skeleton_seconds, d.mapping_seconds, d.diffusion.timings.total, d.diffusion.steps,
+                    d.diffusion.steps == 1 ? "" : "s", a->output.c_str(),
                     write.texcoord1.empty() ? "" : " (the mapping as TEXCOORD_1)", texcoord_note.c_str());
       return;
 #else

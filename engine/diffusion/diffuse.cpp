@@ -7,6 +7,9 @@
 
 #include "atlas_passes.hpp"
 
+#include "sdfkit/diffusion/seams.hpp"
+#include "sdfkit/diffusion/stm.hpp"
+
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/post/smooth.hpp"
 #include "sdfkit/vulkan/context.hpp"
@@ -36,10 +39,10 @@ vk::Pipeline make_raster_pipeline(vk::Context& ctx, bool with_stretch) {
   vk::GraphicsPipelineDescription d;
   d.vertex_shader = "atlas_raster.vert";
   d.fragment_shader = with_stretch ? "atlas_raster.frag" : "atlas_raster_value.frag";
-  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};  // charts, vertex values
   d.push_bytes = sizeof(passes::RasterPush);
   d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, uv)},
-                  {1, 0, VK_FORMAT_R32_SFLOAT, offsetof(passes::RasterVertex, value)},
+                  {1, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, vertex)},
                   {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)},
                   {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, stretch)},
                   {4, 0, VK_FORMAT_R32_SFLOAT, offsetof(passes::RasterVertex, variance)}};
@@ -84,11 +87,46 @@ float sigma_px_of(const Chart& chart, const DiffuseOptions& o, double interp_var
 
 void check_options(const DiffuseOptions& o) {
   const bool r = o.radius_px > 0.0f, s = o.sigma > 0.0f;
+  if (o.steps > kMaxSteps)
+    throw InputError("the diffusion's steps must be a whole number from 1 to " + std::to_string(kMaxSteps) + " (0: automatic)");
   if (!std::isfinite(o.radius_px) || !std::isfinite(o.sigma) || o.radius_px < 0.0f || o.sigma < 0.0f)
     throw InputError("the diffusion's radius and sigma must be finite and positive");
   if (r == s) throw InputError("texture-space diffusion needs exactly one of a radius in texels or a sigma in model units");
   if (r && !o.stretch)
     throw InputError("turning the stretch compensation off needs a sigma in model units (a radius in texels never stretches)");
+}
+
+// One of `steps` successive Gaussians whose variances add up to the whole's: the width over √steps.
+DiffuseOptions step_options(const DiffuseOptions& o, std::uint32_t steps) {
+  DiffuseOptions s = o;
+  const float root = std::sqrt(static_cast<float>(steps));
+  s.sigma = o.sigma / root;
+  s.radius_px = o.radius_px / root;
+  return s;
+}
+
+// DiffuseOptions::steps = 0: the fewest steps whose kernel (kBandSigmas step widths) fits inside
+// the coverage around the typical vertex (the median over the vertices of what each needs,
+// AtlasMapping::vertex_reach), but no step narrower than the mesh's area-weighted RMS edge length
+// (sqrt(8 · interpolation_variance)): the variance the road takes off for the interpolation is
+// the triangle's mean of E(x), which holds for a kernel spanning triangles; a narrower one reads
+// less of it (none at all at a vertex), so steps finer than the triangles would blur too little,
+// and each costs a whole blur. 1 without a reach.
+std::uint32_t auto_steps(const Mesh& mesh, const AtlasMapping& mapping, const DiffuseOptions& o, double interp_variance) {
+  const std::size_t V = mesh.vertex_count();
+  if (mapping.vertex_reach.size() != V || V == 0) return 1;
+  std::vector<double> need(V), width(V);
+  for (std::size_t v = 0; v < V; ++v) {
+    const double tpu = mapping.charts[mapping.vertex_chart[v]].texels_per_unit;
+    width[v] = o.sigma > 0.0f ? static_cast<double>(o.sigma) : (tpu > 0.0 ? o.radius_px / tpu : 0.0);
+    const double reach = mapping.vertex_reach[v];
+    need[v] = reach > 0.0 ? std::pow(kBandSigmas * width[v] / reach, 2.0) : static_cast<double>(kMaxSteps);
+  }
+  const double typical = quantile(std::move(need), 0.5);
+  const double rms_edge = std::sqrt(8.0 * interp_variance);
+  const double finest = rms_edge > 0.0 ? std::floor(std::pow(quantile(std::move(width), 0.5) / rms_edge, 2.0)) : 1.0;
+  const double n = std::min({std::ceil(typical - 1e-9), finest, static_cast<double>(kMaxSteps)});
+  return static_cast<std::uint32_t>(std::max(n, 1.0));
 }
 
 // Model units per texel along the atlas's x and y over an atlas triangle: the columns of the
@@ -249,6 +287,12 @@ void validate_mapping(const Mesh& mesh, const AtlasMapping& m) {
     if (!(s.weight > 0.0f) || !std::isfinite(s.weight)) throw InputError(which() + "'s weight is not finite and positive");
   }
   if (!m.samples.empty() && next != V) throw InputError("the samples must name every vertex, in order");
+  if (!m.vertex_reach.empty() && m.vertex_reach.size() != V)
+    throw InputError("the atlas mapping has " + std::to_string(m.vertex_reach.size()) + " vertex reaches for a mesh of " +
+                     std::to_string(V) + " vertices");
+  for (std::size_t v = 0; v < m.vertex_reach.size(); ++v)
+    if (!(m.vertex_reach[v] >= 0.0f) || !std::isfinite(m.vertex_reach[v]))
+      throw InputError("vertex " + std::to_string(v) + "'s reach is not finite and non-negative");
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {
     const AtlasTriangle& tri = m.triangles[t];
     if (tri.chart >= m.charts.size() || tri.face >= mesh.face_count())
@@ -308,7 +352,8 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     throw DeviceError("a " + std::to_string(size) + "² atlas is larger than the device allows");
 
   DiffuseResult result;
-  const double interp_variance = options.sigma > 0.0f ? interpolation_variance(mesh) : 0.0;
+  const double mesh_interp = options.sigma > 0.0f || options.steps == 0 ? interpolation_variance(mesh) : 0.0;
+  const double interp_variance = options.sigma > 0.0f ? mesh_interp : 0.0;
   // The interpolation's variance is local (the kernel's mean of E(x) around the vertex read
   // back): per chart for one width per chart, per triangle for the stretch-compensated blur.
   // A mesh-wide mean would take a coarse part's large triangles' variance off a fine part's blur
@@ -316,7 +361,10 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   // couplingdown, turbine, oblong, spool, so no blur at all there at sigma = 1 edge).
   const std::vector<double> chart_interp =
       options.sigma > 0.0f ? chart_interpolation_variance(mesh, mapping) : std::vector<double>(mapping.charts.size(), 0.0);
-  result.plan = plan_blur(mapping, options, std::span<const double>(chart_interp));
+  // The Gaussian as `steps` Gaussians of 1/steps its variance, one after another.
+  result.steps = options.steps > 0 ? options.steps : auto_steps(mesh, mapping, options, mesh_interp);
+  const DiffuseOptions step = step_options(options, result.steps);
+  result.plan = plan_blur(mapping, step, std::span<const double>(chart_interp));
   // The stretch blur's prefix sums take two texel buffers' bytes (vec4 per texel).
   if (result.plan.stretch && ctx.capabilities().max_storage_buffer_range &&
       2 * texel_bytes > ctx.capabilities().max_storage_buffer_range)
@@ -347,12 +395,12 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
     // The stretch blur's variance over this triangle: sigma² less what its own interpolation adds.
     const float tri_variance =
-        options.sigma > 0.0f
-            ? static_cast<float>(std::max(static_cast<double>(options.sigma) * options.sigma - triangle_interpolation_variance(x[0], x[1], x[2]), 0.0))
+        step.sigma > 0.0f
+            ? static_cast<float>(std::max(static_cast<double>(step.sigma) * step.sigma - triangle_interpolation_variance(x[0], x[1], x[2]), 0.0))
             : 0.0f;
     if (!ch.wraps_x) {
       const glm::vec2 st = triangle_stretch(x, uv);
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], values[face[k]], t.chart, st, tri_variance});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], face[k], t.chart, st, tri_variance});
       continue;
     }
     const float w = static_cast<float>(ch.width);
@@ -365,7 +413,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     for (int s = -2; s <= 2; ++s) {
       const float shift = static_cast<float>(s) * w;
       if (hi + shift <= static_cast<float>(ch.x0) || lo + shift >= static_cast<float>(ch.x0) + w) continue;
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), values[face[k]], t.chart, st, tri_variance});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), face[k], t.chart, st, tri_variance});
     }
   }
   vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
@@ -411,15 +459,17 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     for (std::size_t v = 0; v < V; ++v) {
       const std::size_t first = i;
       while (i < Q && mapping.samples[i].vertex == v) ++i;
-      ranges[v] = {static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(i - first), values[v], 0u};
+      ranges[v] = {static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(i - first)};
     }
   } else {
     for (std::size_t v = 0; v < V; ++v) {
       q[v] = {mapping.vertex_uv[v], mapping.vertex_chart[v], 1.0f};
-      ranges[v] = {static_cast<std::uint32_t>(v), 1u, values[v], 0u};
+      ranges[v] = {static_cast<std::uint32_t>(v), 1u};
     }
   }
+  // The field in, each step's read-back over it, the result out (host-coherent both ways).
   vk::Buffer value_buf = make_buffer(ctx, V * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Readback);
+  if (V) std::memcpy(value_buf.mapped(), values.data(), V * sizeof(float));
   vk::Buffer atlas_buf;
   if (options.keep_atlas)
     atlas_buf = make_buffer(ctx, VkDeviceSize{size} * size * sizeof(float),
@@ -433,7 +483,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   const auto job_h = graph.import_buffer("atlas.blur_jobs", job_buf.size, host_written(job_buf));
   const auto query_h = graph.import_buffer("atlas.queries", query_buf.size, host_written(query_buf));
   const auto range_h = graph.import_buffer("atlas.ranges", range_buf.size, host_written(range_buf));
-  const auto value_h = graph.import_buffer("atlas.values", value_buf.size, {value_buf.get()});
+  const auto value_h = graph.import_buffer("atlas.values", value_buf.size, host_written(value_buf));
   const auto target = graph.create_image("atlas.raster", {kRasterFormat, size, size, 1});
   // The half-widths exist only for a stretch-compensated blur (a radius in texels, or no blur,
   // never reads them).
@@ -453,22 +503,17 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   rp.charts = chart_h;
   rp.texels = texels;
   rp.stretch = stretch;
-  const float variance =
-      options.sigma > 0.0f ? static_cast<float>(std::max(static_cast<double>(options.sigma) * options.sigma - interp_variance, 0.0)) : 0.0f;
   rp.vertex_count = static_cast<std::uint32_t>(soup.size());
   rp.size = size;
-  const auto rastered = passes::add_atlas_raster_pass(graph, rp);
 
   passes::AtlasBlurPass bp;
   bp.pipeline = &impl_->blur;
   bp.box_pipeline = &impl_->blur_box;
   if (with_stretch) {
     bp.stretch_pipeline = &impl_->blur_stretch;
-    bp.stretch = rastered.stretch;
     bp.prefix = graph.create_buffer("atlas.prefix", 2 * texel_bytes);  // vec4 per texel: (hi, lo)
-    bp.variance = variance;
+    bp.variance = static_cast<float>(std::max(static_cast<double>(step.sigma) * step.sigma - interp_variance, 0.0));
   }
-  bp.texels = rastered.texels;
   bp.scratch = scratch;
   bp.charts = chart_h;
   bp.jobs = job_h;
@@ -477,18 +522,39 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   bp.columns_fused = counts[2];
   bp.columns_cascade = counts[3];
   bp.size = size;
-  const auto blurred = options.blur ? passes::add_atlas_blur_passes(graph, bp) : rastered.texels;
 
   passes::AtlasSamplePass sp;
   sp.pipeline = &impl_->sample;
-  sp.texels = blurred;
   sp.charts = chart_h;
   sp.queries = query_h;
   sp.ranges = range_h;
   sp.values = value_h;
   sp.vertex_count = static_cast<std::uint32_t>(V);
   sp.size = size;
-  passes::add_atlas_sample_pass(graph, sp);
+
+  // Each step rasterizes the values the last one read back, so the overlap bands carry the
+  // neighbouring charts' blurred values into the next blur (DiffuseOptions::steps).
+  // The half-widths depend on the map alone: the first step draws them, the others only values.
+  vk::BufferHandle blurred;
+  for (std::uint32_t k = 0; k < result.steps; ++k) {
+    rp.values = sp.values;
+    const passes::AtlasRasterOutput rastered = passes::add_atlas_raster_pass(graph, rp);
+    rp.pipeline = &impl_->raster;
+    rp.target = rastered.target;
+    rp.stretch_target = {};
+    if (k == 0) bp.stretch = rastered.stretch;
+    blurred = rastered.texels;
+    if (options.blur) {
+      bp.texels = rastered.texels;
+      const passes::AtlasBlurOutput out = passes::add_atlas_blur_passes(graph, bp);
+      blurred = out.texels;
+      bp.scratch = out.scratch;
+      bp.prefix = out.prefix;
+    }
+    rp.texels = blurred;
+    sp.texels = blurred;
+    sp.values = passes::add_atlas_sample_pass(graph, sp);
+  }
 
   if (options.keep_atlas) {
     passes::AtlasDilatePass dp;

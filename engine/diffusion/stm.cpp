@@ -851,6 +851,9 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     return t * t * (3.0 - 2.0 * t);
   };
   if (blend) own_weight.assign(V, 1.0);
+  // Per vertex, with a band: how far around it the chart that covers it deepest reaches, along the
+  // surface, up to the band (AtlasMapping::vertex_reach).
+  std::vector<float> reach(options.overlap > 0 ? V : 0, 0.0f);
   // 5b. Overlap bands (StmOptions::overlap): per chart, the faces within `overlap` of its own
   // vertices along the surface (Dijkstra over the edges, from all its vertices at once), grown
   // face by face out of the faces it already holds, through faces its map keeps oriented as the
@@ -873,10 +876,10 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     std::vector<std::uint8_t> face_state(F, 0);  // 1: in the chart, 2: rejected
     using Item = std::pair<double, std::uint32_t>;
     std::vector<Item> heap;
-    // Per chart, when blending: covered vertices; cover = inf (not covered), -1 (covered, coverage
-    // farther than the blend), or the distance to the coverage's end.
+    // Per chart: covered vertices; cover = inf (not covered), -1 (covered, coverage farther than
+    // the blend), or the distance to the coverage's end.
     std::vector<std::uint32_t> covered;
-    std::vector<double> cover(blend ? V : 0, std::numeric_limits<double>::infinity());
+    std::vector<double> cover(V, std::numeric_limits<double>::infinity());
     std::vector<double> dsum(blend ? V : 0, 0.0), dcnt(blend ? V : 0, 0.0);
     const double distortion_k = kBlendDistortion;
     const std::size_t own_triangles = local.size();
@@ -1014,7 +1017,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             ChartMap& m = maps[c];
             for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
           }
-      if (blend) {
+      {
         // The vertices the chart covers (corners of its faces), and their distance along the
         // surface to where its coverage ends (covered vertices with a face around them it lacks).
         covered.clear();
@@ -1048,7 +1051,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         // The chart's distortion around each covered vertex (StmOptions::blend): the mean over its
         // faces in the chart of log² σ1 + log² σ2, σ1, σ2 the singular values of the map surface ->
         // chart (both in model units, so 1 where the chart keeps lengths).
-        if (distortion_k > 0)
+        if (blend && distortion_k > 0)
           for (std::uint32_t f : faces) {
             if (face_state[f] != 1) continue;
             glm::dvec2 uv[3];
@@ -1075,6 +1078,12 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             for (std::uint32_t v : t) dsum[v] += delta, dcnt[v] += 1;
           }
         for (std::uint32_t v : covered) {
+          // The deepest coverage of the vertex over the charts (AtlasMapping::vertex_reach).
+          reach[v] = std::max(reach[v], static_cast<float>(cover[v] < 0 ? blend_reach : cover[v]));
+          if (!blend) {
+            cover[v] = std::numeric_limits<double>::infinity();
+            continue;
+          }
           double w = cover[v] < 0 ? 1.0 : blend_weight(cover[v]);
           if (distortion_k > 0 && dcnt[v] > 0) w *= std::exp(-distortion_k * dsum[v] / dcnt[v]);
           dsum[v] = 0, dcnt[v] = 0;
@@ -1166,6 +1175,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     am.triangles.push_back(at);
   }
   am.vertex_chart = vchart;
+  am.vertex_reach = std::move(reach);
   am.vertex_uv.resize(V);
   for (std::size_t v = 0; v < V; ++v) {
     glm::vec2 q = to_texel(vchart[v], vlocal[v]);

@@ -575,6 +575,14 @@ class UtilityTest(unittest.TestCase):
         diffused = sdfkit.diffuse(v, f, noisy, sigma=0.1, atlas_size=512)
         self.assertEqual(diffused.dtype, np.float32)
         self.assertLess(float(np.std(diffused)), 0.5 * float(np.std(noisy)))
+        # steps: two blurs of sigma / sqrt(2) are not one blur of sigma (the kernel is carried on
+        # between them), and both smooth; more than 256 is refused.
+        one = sdfkit.diffuse(v, f, noisy, sigma=0.1, steps=1, atlas_size=512)
+        two = sdfkit.diffuse(v, f, noisy, sigma=0.1, steps=2, atlas_size=512)
+        self.assertGreater(float(np.max(np.abs(one - two))), 1e-4)
+        self.assertLess(float(np.std(two)), 0.5 * float(np.std(noisy)))
+        with self.assertRaisesRegex(sdfkit.InputError, "steps"):
+            sdfkit.diffuse(v, f, noisy, sigma=0.1, steps=257, atlas_size=512)
         with self.assertRaisesRegex(sdfkit.InputError, "exactly one"):
             sdfkit.diffuse(v, f, noisy)
         with self.assertRaisesRegex(sdfkit.InputError, "one value per vertex"):

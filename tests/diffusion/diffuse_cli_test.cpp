@@ -105,7 +105,8 @@ TEST(DiffuseCli, UsageErrorsExitTwo) {
   for (const std::string args : {"--texture-space", "--texture-space --radius 2 --sigma 0.1",
                                   "--texture-space --radius 2 --rings 3", "--radius 2", "--atlas-png a.png",
                                   "--texture-space --radius 2 --atlas-png atlas.jpg",
-                                  "--texture-space --radius 2 --atlas-size 8"}) {
+                                  "--texture-space --radius 2 --atlas-size 8", "--steps 2",
+                                  "--texture-space --radius 2 --steps 257", "--texture-space --radius 2 --steps -1"}) {
     const CommandResult r = run_command(kCli + " smooth " + in + " -o " + out + " " + args, dir.dir());
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_FALSE(std::filesystem::exists(out));
@@ -129,6 +130,21 @@ TEST(DiffuseCli, SmoothTextureSpaceWritesTheResultAndTheAtlas) {
                   dir.dir());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("diffused in texture space"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" step"), std::string::npos) << "the run says how many blur steps it took: " << r.out;
+  // --steps is honoured: one blur and three steps of the same sigma differ.
+  const std::string one = dir.path("one.ply"), three = dir.path("three.ply");
+  for (const auto& [file, n] : {std::pair{one, 1}, std::pair{three, 3}}) {
+    const CommandResult s = run_command(kCli + " smooth " + sdf + " -o " + file + " --texture-space --sigma 0.05 --atlas-size 512 --steps " +
+                                            std::to_string(n),
+                                        dir.dir());
+    ASSERT_EQ(s.exit_code, 0) << s.err;
+    EXPECT_NE(s.out.find("in " + std::to_string(n) + " step"), std::string::npos) << s.out;
+  }
+  const io::FieldFile v1 = io::read_field(one, io::ValuesRequired::Yes), v3 = io::read_field(three, io::ValuesRequired::Yes);
+  ASSERT_EQ(v1.values.size(), v3.values.size());
+  float most = 0.0f;
+  for (std::size_t i = 0; i < v1.values.size(); ++i) most = std::max(most, std::abs(v1.values[i] - v3.values[i]));
+  EXPECT_GT(most, 0.0f);
   const io::FieldFile before = io::read_field(sdf, io::ValuesRequired::Yes), after = io::read_field(out, io::ValuesRequired::Yes);
   ASSERT_EQ(before.values.size(), after.values.size());
   float lo = 1e30f, hi = -1e30f, alo = 1e30f, ahi = -1e30f;

@@ -61,6 +61,11 @@ struct AtlasMapping {
   // result is continuous across chart borders. Empty: every vertex reads vertex_chart at
   // vertex_uv alone.
   std::vector<VertexSample> samples;
+  // Optional, V entries where present: how far around each vertex (model units, along the surface)
+  // the chart that covers it deepest reaches before its coverage ends (where its overlap band
+  // stops at a fold, or at the band's width). A blur whose kernel reaches further than this sees
+  // only part of its kernel; DiffuseOptions::steps = 0 sizes its steps from it. Empty: unknown.
+  std::vector<float> vertex_reach;
 };
 
 }  // namespace sdfkit::diffusion

@@ -3,9 +3,10 @@
 // atlas of a mapping (atlas.hpp), blurred there by a Gaussian and read back per vertex, all on the
 // device through one render graph (passes/atlas_*.cpp):
 //
-//   atlas_raster  the AtlasTriangles, per-corner values, into an RG32F atlas (value, coverage 1),
-//                 each fragment clipped to its chart's rectangle (a triangle across the seam of a
-//                 wrapping chart is drawn once per side); copied into a texel buffer. For the
+//   atlas_raster  the AtlasTriangles, each corner with its mesh vertex's value, into an RG32F
+//                 atlas (value, coverage 1), each fragment clipped to its chart's rectangle (a
+//                 triangle across the seam of a wrapping chart is drawn once per side); copied
+//                 into a texel buffer. For the
 //                 stretch-compensated blur only, beside it each triangle's stretch (model units
 //                 per texel along x and y, the columns of its map's Jacobian) into a second
 //                 RG32F target, copied into a stretch buffer (a radius in texels: one target)
@@ -20,6 +21,11 @@
 //   atlas_sample  per vertex, bilinear at vertex_uv inside the vertex's chart, normalized; with
 //                 AtlasMapping::samples, the weighted blend of such reads in every chart covering
 //                 the vertex (build_stm's partition of unity across chart borders)
+//   steps         (DiffuseOptions::steps) the three above, raster -> blur -> sample, once per step:
+//                 each step rasterizes the per-vertex values the last one read back (the raster's
+//                 vertex stage reads them by vertex index), so a chart's overlap band carries its
+//                 neighbours' blurred values into the next blur, and a Gaussian wider than where
+//                 the bands reach runs as several narrower ones whose variances add up to it
 //   atlas_dilate  (only when the atlas itself is asked for) the normalized atlas, uncovered texels
 //                 and half the gutter around each chart filled from the nearest covered texel of the
 //                 same chart, for a texture consumer (TEXCOORD_1) and the PNG
@@ -71,7 +77,17 @@ struct DiffuseOptions {
   // (BlurPlan::stretch false) and this flag must stay at its default: a radius with stretch off is
   // an InputError.
   bool stretch = true;
+  // The Gaussian as this many successive Gaussians of width sigma / √steps (radius_px / √steps),
+  // whose variances add up to the whole's (1 … kMaxSteps). Each step rasterizes the values the
+  // previous one read back, so what a chart's overlap band holds is refreshed from its
+  // neighbours' blurred values between steps: the kernel carries on across chart borders and
+  // round a small part, where one blur stops at the band's end (a band stops where its chart's
+  // map would fold). Each step costs what one blur costs. 0: as many as the mapping's reach asks
+  // for (AtlasMapping::vertex_reach; diffuse.cpp auto_steps), 1 where it has none; 1 is the
+  // paper's single blur (Table 2).
+  std::uint32_t steps = 0;
 };
+inline constexpr std::uint32_t kMaxSteps = 256;
 
 // Where the time went (milliseconds). Device times only with DiffuseOptions::profile.
 struct DiffuseTimings {
@@ -144,7 +160,8 @@ struct DiffuseResult {
   std::vector<float> values;  // per vertex
   std::vector<float> atlas;   // size × size, row y at [y * size], NaN where no chart reaches (keep_atlas)
   DiffuseTimings timings;
-  BlurPlan plan;
+  BlurPlan plan;              // of one step
+  std::uint32_t steps = 1;    // the steps run (DiffuseOptions::steps)
   // The names of the render graph's resources that its live passes use (imported and
   // transient, as compiled), e.g. "atlas.raster.stretch" only for a stretch-compensated blur.
   std::vector<std::string> graph_resources;
