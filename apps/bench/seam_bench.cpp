@@ -29,11 +29,16 @@
 // with one width per chart, from the same mapping in the same run (the stretch compensation's
 // own effect), and the summary counts it too.
 //
+// --steps N: the blur's steps (DiffuseOptions::steps; default 0, automatic from the mapping's reach:
+// the "blur steps" column says how many ran); 1 is the paper's single blur. --no-per-chart skips
+// the one-width-per-chart comparison run (its columns then read nan / 0), which halves the time.
+//
 // --by-kind: after each row, where the error sits: per chart kind (bone, joint, sheet) of the
 // vertices' own charts, their share of the vertices, the RMS of texture space and of k-ring
 // against heat over them, and the kind's share of texture space's squared error.
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 8,1] [--no-band] [--no-blend] [--no-stretch] [--by-kind] [--atlas-size N] [--models] [MESH...]
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 8,1] [--steps N] [--no-band] [--no-blend] [--no-stretch] [--no-per-chart]
+//                     [--by-kind] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -66,9 +71,10 @@ int main(int argc, char** argv) {
   CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
   std::vector<std::string> meshes;
   std::vector<float> sigmas;
-  bool no_band = false, no_blend = false, no_stretch = false, by_kind = false;
+  bool no_band = false, no_blend = false, no_stretch = false, by_kind = false, no_per_chart = false;
   std::uint32_t atlas_size = 2048;
   bool models = false;
+  std::uint32_t blur_steps = 0;
   app.add_option("meshes", meshes, "Mesh files (closed)")->check(CLI::ExistingFile);
   app.add_flag("--models", models, "Also generated shapes: capsule, torus, the skeleton models (star, genus 2, C and S plates)");
   std::string sigma_list = "1,2,3,5";
@@ -81,7 +87,11 @@ int main(int argc, char** argv) {
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
   app.add_flag("--no-blend", no_blend, "Every vertex read back from its own chart only (no blend over the charts covering it)");
   app.add_flag("--no-stretch", no_stretch, "One blur width in texels per chart (its mean scale) instead of one per texel from the map's local stretch");
+  app.add_flag("--no-per-chart", no_per_chart, "Skip the comparison run with one blur width per chart (the 'tex/k per chart' columns: n/a); halves the time");
   app.add_flag("--by-kind", by_kind, "After each row, the error against heat per chart kind (bone, joint, sheet)");
+  app.add_option("--steps", blur_steps, "The blur's steps (DiffuseOptions::steps): 0 = automatic from the mapping's reach, 1 = one blur (the paper's)")
+      ->check(CLI::Range(0u, diffusion::kMaxSteps))
+      ->capture_default_str();
   app.add_option("--atlas-size", atlas_size, "Atlas size in texels")->check(CLI::Range(16, 16384));
   CLI11_PARSE(app, argc, argv);
   if (meshes.empty() && !models) {
@@ -116,16 +126,17 @@ int main(int argc, char** argv) {
   try {
     vk::Context ctx{vk::ContextConfig{}};
     diffusion::Diffuser diffuser(ctx);
-    std::printf("atlas %u², band %s, %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
+    std::printf("atlas %u², band %s, %s, %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
                 "Against heat diffusion: texture Pearson / median rel. / RMS; k-ring RMS; tex/k = RMS ratio.\n\n",
                 atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back",
-                no_stretch ? "one blur width per chart" : "stretch-compensated blur");
+                no_stretch ? "one blur width per chart" : "stretch-compensated blur",
+                blur_steps == 0 ? "automatic steps" : (blur_steps == 1 ? "one blur (1 step)" : (std::to_string(blur_steps) + " steps").c_str()));
     std::printf("Heat reference: %d implicit step%s of t / %d", heat_steps[0], heat_steps[0] == 1 ? "" : "s", heat_steps[0]);
     if (heat_steps.size() > 1) std::printf(" (the last column: against %zu more)", heat_steps.size() - 1);
     std::printf(".\n\n");
     std::printf("| mesh | vertices | sigma (edges) | charts | atlas triangles / faces | seam ratio (heat) | pearson | median rel | "
-                "rms | k-ring (k) rms | tex/k | tex/k per chart | overlap | build_stm s | other steps: pearson / median rel / tex/k |\n"
-                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                "rms | k-ring (k) rms | tex/k | tex/k per chart | overlap | build_stm s | blur steps | other steps: pearson / median rel / tex/k |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     // Per sigma and heat reference, over the meshes: seam ratio, tex/k, Pearson, median relative
     // difference (the summary at the end).
     struct Summary {
@@ -161,7 +172,9 @@ int main(int argc, char** argv) {
           diffusion::DiffuseOptions o;
           o.sigma = sigma;
           o.stretch = !no_stretch;
-          const std::vector<float> tex = diffuser.run(m, stm.mapping, u, o).values;
+          o.steps = blur_steps;
+          const diffusion::DiffuseResult run = diffuser.run(m, stm.mapping, u, o);
+          const std::vector<float>& tex = run.values;
           const double ratio = diffusion::seam_ratio(m, stm.mapping, tex);
           std::vector<std::vector<float>> heats;
           for (const int steps : heat_steps) heats.push_back(test::heat_diffusion(m, u, sigma, steps));
@@ -178,18 +191,18 @@ int main(int argc, char** argv) {
           // The same mapping with one blur width per chart (what the stretch compensation changes).
           diffusion::DiffuseOptions per_chart = o;
           per_chart.stretch = false;
-          const std::vector<float> tex1 = diffuser.run(m, stm.mapping, u, per_chart).values;
-          const double rms1 = test::rms_difference(tex1, heat);
-          std::printf("| %s | %zu | %g | %zu | %.2f | %.2f (%.2f) | %.4f | %.2f %% | %.4f | %.4f (%d) | %.2f | %.2f | %.2f %% | %.2f | ", name.c_str(),
+          const std::vector<float> tex1 = no_per_chart ? std::vector<float>{} : diffuser.run(m, stm.mapping, u, per_chart).values;
+          const double rms1 = tex1.empty() ? std::nan("") : test::rms_difference(tex1, heat);
+          std::printf("| %s | %zu | %g | %zu | %.2f | %.2f (%.2f) | %.4f | %.2f %% | %.4f | %.4f (%d) | %.2f | %.2f | %.2f %% | %.2f | %u | ", name.c_str(),
                       m.vertex_count(), static_cast<double>(edges), stm.mapping.charts.size(),
                       static_cast<double>(stm.mapping.triangles.size()) / static_cast<double>(m.triangles.size()), ratio, heat_ratio,
                       c.pearson, 100.0 * c.median_relative, rms, krms, ko.rings, krms > 0 ? rms / krms : 0.0,
-                      krms > 0 ? rms1 / krms : 0.0, 100.0 * stm.quality.overlap, stm.quality.seconds);
+                      krms > 0 ? rms1 / krms : 0.0, 100.0 * stm.quality.overlap, stm.quality.seconds, run.steps);
           // Every reference (the first again, for the summary): the same results measured against it.
           for (std::size_t hi = 0; hi < heat_steps.size(); ++hi) {
             const FieldComparison ch = compare_fields(tex, heats[hi]);
             const double rh = test::rms_difference(tex, heats[hi]), kh = test::rms_difference(kr, heats[hi]);
-            const double r1 = test::rms_difference(tex1, heats[hi]);
+            const double r1 = tex1.empty() ? 0.0 : test::rms_difference(tex1, heats[hi]);
             if (hi > 0)
               std::printf("%d: %.4f / %.2f %% / %.2f; ", heat_steps[hi], ch.pearson, 100.0 * ch.median_relative, kh > 0 ? rh / kh : 0.0);
             Summary& su = summary[si][hi];
@@ -197,7 +210,7 @@ int main(int argc, char** argv) {
             su.texk.push_back(kh > 0 ? rh / kh : 0.0);
             su.pearson.push_back(ch.pearson);
             su.median_rel.push_back(ch.median_relative);
-            su.texk_per_chart.push_back(kh > 0 ? r1 / kh : 0.0);
+            if (!tex1.empty()) su.texk_per_chart.push_back(kh > 0 ? r1 / kh : 0.0);
           }
           std::printf("|\n");
           if (by_kind) {
