@@ -207,6 +207,50 @@ struct Surface {
       s += sdf.empty() ? glm::length(original.positions[k] - p) : 0.5 * sdf[k];
     return static_cast<float>(s / static_cast<double>(members.size()));
   }
+
+  // Where a region of vertices (`part`, not empty) gets a curve node: the mean of its centre
+  // points, or where that is outside the solid (a centre point can be outside where no inside
+  // point was found for its vertex: thin wings and fins) the nearest of its 16 nearest centre
+  // points that is inside; with the vertices of `part` that see it. nullopt when none of the 16
+  // is inside or under half of the vertices see the point.
+  struct RegionNode {
+    glm::vec3 point;
+    std::vector<std::uint32_t> seeing;
+  };
+  std::optional<RegionNode> region_node(const std::vector<std::uint32_t>& part) const {
+    glm::dvec3 mean(0.0);
+    for (std::uint32_t k : part) mean += glm::dvec3(centre[k]);
+    glm::vec3 p(mean / static_cast<double>(part.size()));
+    if (!bvh.inside(p)) {
+      std::vector<std::pair<float, std::uint32_t>> by_distance;
+      for (std::uint32_t k : part) by_distance.push_back({glm::length(centre[k] - p), k});
+      const std::size_t tried = std::min<std::size_t>(by_distance.size(), 16);
+      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
+                        by_distance.end());
+      bool found = false;
+      for (std::size_t i = 0; i < tried && !found; ++i)
+        if (bvh.inside(centre[by_distance[i].second])) p = centre[by_distance[i].second], found = true;
+      if (!found) return std::nullopt;
+    }
+    RegionNode node{p, {}};
+    for (std::uint32_t k : part)
+      if (sees(k, p)) node.seeing.push_back(k);
+    if (node.seeing.empty() || 2 * node.seeing.size() < part.size()) return std::nullopt;
+    return node;
+  }
+
+  // Of the nodes `candidates` (index, position), the nearest to p of the 64 nearest whose
+  // segment to p stays inside the solid (ties to the lower index); UINT32_MAX when none does.
+  std::uint32_t nearest_seen_node(const glm::vec3& p, const std::vector<std::pair<std::uint32_t, glm::vec3>>& candidates) const {
+    std::vector<std::pair<float, std::uint32_t>> by_distance;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      by_distance.push_back({glm::length(candidates[i].second - p), static_cast<std::uint32_t>(i)});
+    const std::size_t tried = std::min<std::size_t>(by_distance.size(), 64);
+    std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried), by_distance.end());
+    for (std::size_t i = 0; i < tried; ++i)
+      if (!bvh.segment_blocked(p, candidates[by_distance[i].second].second)) return candidates[by_distance[i].second].first;
+    return UINT32_MAX;
+  }
 };
 
 // Sheet nodes: the sheet vertices' sheet points (`point`, from Surface::sheet_point) clustered on a grid of
@@ -467,39 +511,13 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // see it, joined to the nearest curve node it sees; false when under half of them see it or
   // no node is seen from it.
   auto add_node = [&](const std::vector<std::uint32_t>& part) {
-    glm::dvec3 mean(0.0);
-    for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
-    glm::vec3 p(mean / static_cast<double>(part.size()));
-    if (!surface.bvh.inside(p)) {
-      // The nearest centre point inside the solid (a centre point can be outside where no
-      // inside point was found for its vertex: thin wings and fins); none of the 16 nearest:
-      // no node.
-      std::vector<std::pair<float, std::uint32_t>> by_distance;
-      for (std::uint32_t k : part) by_distance.push_back({glm::length(surface.centre[k] - p), k});
-      const std::size_t tried = std::min<std::size_t>(by_distance.size(), 16);
-      std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
-                        by_distance.end());
-      bool found = false;
-      for (std::size_t i = 0; i < tried && !found; ++i)
-        if (surface.bvh.inside(surface.centre[by_distance[i].second]))
-          p = surface.centre[by_distance[i].second], found = true;
-      if (!found) return false;
-    }
-    std::vector<std::uint32_t> seeing;
-    for (std::uint32_t k : part)
-      if (surface.sees(k, p)) seeing.push_back(k);
-    if (2 * seeing.size() < part.size()) return false;
-    std::vector<std::pair<float, std::uint32_t>> by_distance;
-    for (std::uint32_t c = 0; c < curve_nodes; ++c) by_distance.push_back({glm::length(position[c] - p), c});
-    const std::size_t tried = std::min<std::size_t>(by_distance.size(), 64);
-    std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
-                      by_distance.end());
-    std::uint32_t attach = UINT32_MAX;
-    for (std::size_t i = 0; i < tried; ++i)
-      if (!surface.bvh.segment_blocked(p, position[by_distance[i].second])) {
-        attach = by_distance[i].second;
-        break;
-      }
+    const std::optional<Surface::RegionNode> node = surface.region_node(part);
+    if (!node) return false;
+    const glm::vec3 p = node->point;
+    const std::vector<std::uint32_t>& seeing = node->seeing;
+    std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
+    for (std::uint32_t c = 0; c < curve_nodes; ++c) curve.push_back({c, position[c]});
+    const std::uint32_t attach = surface.nearest_seen_node(p, curve);
     if (attach == UINT32_MAX) return false;
     const auto c = static_cast<std::uint32_t>(curve_nodes++);
     position.push_back(p);
@@ -1538,37 +1556,14 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         }
       // A new curve leaf for `part` (the region step's add_node on the skeleton's nodes).
       auto add_leaf = [&](const std::vector<std::uint32_t>& part) {
-        glm::dvec3 mean(0.0);
-        for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
-        glm::vec3 p(mean / static_cast<double>(part.size()));
-        if (!surface.bvh.inside(p)) {
-          std::vector<std::pair<float, std::uint32_t>> by_distance;
-          for (std::uint32_t k : part) by_distance.push_back({glm::length(surface.centre[k] - p), k});
-          const std::size_t tried = std::min<std::size_t>(by_distance.size(), 16);
-          std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
-                            by_distance.end());
-          bool found = false;
-          for (std::size_t i = 0; i < tried && !found; ++i)
-            if (surface.bvh.inside(surface.centre[by_distance[i].second]))
-              p = surface.centre[by_distance[i].second], found = true;
-          if (!found) return false;
-        }
-        std::vector<std::uint32_t> seeing;
-        for (std::uint32_t k : part)
-          if (surface.sees(k, p)) seeing.push_back(k);
-        if (seeing.empty() || 2 * seeing.size() < part.size()) return false;
-        std::vector<std::pair<float, std::uint32_t>> by_distance;
+        std::optional<Surface::RegionNode> found = surface.region_node(part);
+        if (!found) return false;
+        const glm::vec3 p = found->point;
+        std::vector<std::uint32_t>& seeing = found->seeing;
+        std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
         for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
-          if (!sk.nodes[c].sheet) by_distance.push_back({glm::length(sk.nodes[c].position - p), c});
-        const std::size_t tried = std::min<std::size_t>(by_distance.size(), 64);
-        std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(tried),
-                          by_distance.end());
-        std::uint32_t attach = UINT32_MAX;
-        for (std::size_t i = 0; i < tried; ++i)
-          if (!surface.bvh.segment_blocked(p, sk.nodes[by_distance[i].second].position)) {
-            attach = by_distance[i].second;
-            break;
-          }
+          if (!sk.nodes[c].sheet) curve.push_back({c, sk.nodes[c].position});
+        const std::uint32_t attach = surface.nearest_seen_node(p, curve);
         if (attach == UINT32_MAX) return false;
         // Each node keeps a vertex: where all of a node's vertices would move, the one nearest
         // to it stays.
