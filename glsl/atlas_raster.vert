@@ -6,7 +6,7 @@ layout(location = 0) in vec2 in_uv;
 layout(location = 1) in uint in_vertex;  // the mesh vertex whose value the corner carries
 layout(location = 2) in uint in_chart;
 layout(location = 3) in vec2 in_stretch;  // model units per texel along x, y (the triangle's)
-layout(location = 4) in float in_variance;  // the blur's variance left over the triangle, model units²
+layout(location = 4) in vec2 in_variance;  // the blur's variance left over the triangle along x, y, model units²
 
 // One value per mesh vertex: the field, or the previous step's read-back (DiffuseOptions::steps).
 layout(std430, binding = 1) readonly buffer Values { float values[]; };
@@ -18,7 +18,7 @@ layout(push_constant) uniform Push {
 layout(location = 0) out float out_value;
 layout(location = 1) flat out uint out_chart;
 layout(location = 2) flat out vec2 out_stretch;
-layout(location = 3) flat out float out_variance;
+layout(location = 3) flat out vec2 out_variance;
 
 void main() {
   gl_Position = vec4(in_uv * pc.scale.x - 1.0, 0.0, 1.0);

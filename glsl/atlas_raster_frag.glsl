@@ -13,7 +13,7 @@ layout(std430, binding = 0) readonly buffer Charts { Chart charts[]; };
 layout(location = 0) in float in_value;
 layout(location = 1) flat in uint in_chart;
 layout(location = 2) flat in vec2 in_stretch;
-layout(location = 3) flat in float in_variance;  // the blur's variance left over this triangle (RasterVertex::variance)
+layout(location = 3) flat in vec2 in_variance;  // the blur's variance left over this triangle along x, y (RasterVertex::variance)
 layout(location = 0) out vec2 out_texel;
 #ifndef ATLAS_RASTER_VALUE_ONLY
 layout(location = 1) out vec2 out_half_width;
@@ -29,6 +29,6 @@ void main() {
   if (p.x < r.x || p.y < r.y || p.x >= r.x + r.z || p.y >= r.y + r.w) discard;
   out_texel = vec2(in_value, 1.0);
 #ifndef ATLAS_RASTER_VALUE_ONLY
-  out_half_width = vec2(stretch_half_width(in_stretch.x, in_variance), stretch_half_width(in_stretch.y, in_variance));
+  out_half_width = vec2(stretch_half_width(in_stretch.x, in_variance.x), stretch_half_width(in_stretch.y, in_variance.y));
 #endif
 }

@@ -32,13 +32,15 @@ struct RasterVertex {
   std::uint32_t vertex;  // the mesh vertex whose value the corner carries (AtlasRasterPass::values)
   std::uint32_t chart; // fragments outside this chart's rectangle are discarded
   glm::vec2 stretch;   // the triangle's |dX/du|, |dX/dv|: model units per texel along the atlas's x and y
-  // The Gaussian's variance per axis left for the stretch-compensated blur over this triangle,
-  // model units²: sigma² less the variance the triangle's own linear interpolation adds
-  // (diffusion::triangle_interpolation_variance), so a mesh's fine and coarse parts each get
-  // what they lack of sigma². 0 for a blur of one width in texels (unused there).
-  float variance;
+  // The Gaussian's variance left for the stretch-compensated blur over this triangle along the
+  // atlas's x and y, model units²: sigma² less the variance the triangle's own linear
+  // interpolation adds along each axis's surface direction
+  // (diffusion::triangle_interpolation_variance_along), so a mesh's fine and coarse parts, and a
+  // long thin triangle's two directions, each get what they lack of sigma². 0 for a blur of one
+  // width in texels (unused there).
+  glm::vec2 variance;
 };
-static_assert(sizeof(RasterVertex) == 28);
+static_assert(sizeof(RasterVertex) == 32);
 
 // One read of a vertex's value (atlas_sample.comp): AtlasMapping's VertexSample.
 struct SampleQuery {

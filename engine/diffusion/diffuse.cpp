@@ -45,7 +45,7 @@ vk::Pipeline make_raster_pipeline(vk::Context& ctx, bool with_stretch) {
                   {1, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, vertex)},
                   {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)},
                   {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, stretch)},
-                  {4, 0, VK_FORMAT_R32_SFLOAT, offsetof(passes::RasterVertex, variance)}};
+                  {4, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, variance)}};
   d.vertex_stride = sizeof(passes::RasterVertex);
   d.color_formats = {kRasterFormat};  // (value, coverage)
   if (with_stretch) d.color_formats.push_back(kRasterFormat);  // the half-widths
@@ -129,17 +129,39 @@ std::uint32_t auto_steps(const Mesh& mesh, const AtlasMapping& mapping, const Di
   return static_cast<std::uint32_t>(std::max(n, 1.0));
 }
 
-// Model units per texel along the atlas's x and y over an atlas triangle: the columns of the
-// Jacobian dX/d(uv) = [x1 - x0, x2 - x0] · [uv1 - uv0, uv2 - uv0]^-1. (0, 0) for a triangle
-// degenerate in the atlas (the blur then takes its chart's mean scale).
-glm::vec2 triangle_stretch(const glm::vec3 (&x)[3], const glm::vec2 (&uv)[3]) {
+// The map's Jacobian over an atlas triangle, dX/d(uv) = [x1 - x0, x2 - x0] · [uv1 - uv0, uv2 - uv0]^-1:
+// its columns are the surface's steps (model units) per texel along the atlas's x and y. Both
+// zero for a triangle degenerate in the atlas (the blur then takes its chart's mean scale).
+struct TriangleMap {
+  glm::dvec3 du{0.0}, dv{0.0};
+};
+TriangleMap triangle_map(const glm::vec3 (&x)[3], const glm::vec2 (&uv)[3]) {
   const glm::dvec3 e1 = glm::dvec3(x[1]) - glm::dvec3(x[0]), e2 = glm::dvec3(x[2]) - glm::dvec3(x[0]);
   const glm::dvec2 d1 = glm::dvec2(uv[1]) - glm::dvec2(uv[0]), d2 = glm::dvec2(uv[2]) - glm::dvec2(uv[0]);
   const double det = d1.x * d2.y - d1.y * d2.x;
-  if (!(std::abs(det) > 1e-9)) return glm::vec2(0.0f);
-  const glm::dvec3 du = (e1 * d2.y - e2 * d1.y) / det, dv = (e2 * d1.x - e1 * d2.x) / det;
-  const glm::vec2 s(static_cast<float>(glm::length(du)), static_cast<float>(glm::length(dv)));
-  return std::isfinite(s.x) && std::isfinite(s.y) ? s : glm::vec2(0.0f);
+  if (!(std::abs(det) > 1e-9)) return {};
+  TriangleMap m{(e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det};
+  const bool finite = std::isfinite(glm::length(m.du)) && std::isfinite(glm::length(m.dv));
+  return finite ? m : TriangleMap{};
+}
+
+// Model units per texel along the atlas's x and y: the lengths of the map's columns.
+glm::vec2 triangle_stretch(const TriangleMap& m) {
+  return {static_cast<float>(glm::length(m.du)), static_cast<float>(glm::length(m.dv))};
+}
+
+// The stretch-compensated blur's variance left over a triangle along each atlas axis: sigma²
+// less what the triangle's interpolation adds along that axis's surface direction (the map's
+// column; the triangle's mean over both where the map is degenerate).
+glm::vec2 triangle_blur_variance(const glm::vec3 (&x)[3], const TriangleMap& m, double sigma) {
+  const double s2 = sigma * sigma;
+  const double iso = triangle_interpolation_variance(x[0], x[1], x[2]);
+  const auto left = [&](const glm::dvec3& column) {
+    const double len = glm::length(column);
+    const double e = len > 0.0 ? triangle_interpolation_variance_along(x[0], x[1], x[2], column / len) : iso;
+    return static_cast<float>(std::max(s2 - e, 0.0));
+  };
+  return {left(m.du), left(m.dv)};
 }
 
 }  // namespace
@@ -163,6 +185,12 @@ std::array<std::uint32_t, 3> box_radii(float sigma_px) {
 double triangle_interpolation_variance(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2) {
   const glm::dvec3 a(p0), b(p1), c(p2);
   return (glm::dot(b - a, b - a) + glm::dot(c - b, c - b) + glm::dot(a - c, a - c)) / 24.0;
+}
+
+double triangle_interpolation_variance_along(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2, const glm::dvec3& d) {
+  const glm::dvec3 a(p0), b(p1), c(p2);
+  const double x = glm::dot(b - a, d), y = glm::dot(c - b, d), z = glm::dot(a - c, d);
+  return (x * x + y * y + z * z) / 12.0;
 }
 
 double interpolation_variance(const Mesh& mesh) {
@@ -393,14 +421,15 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     const auto& face = mesh.triangles[t.face];
     glm::vec2 uv[3] = {t.uv[0], t.uv[1], t.uv[2]};
     const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
-    // The stretch blur's variance over this triangle: sigma² less what its own interpolation adds.
-    const float tri_variance =
-        step.sigma > 0.0f
-            ? static_cast<float>(std::max(static_cast<double>(step.sigma) * step.sigma - triangle_interpolation_variance(x[0], x[1], x[2]), 0.0))
-            : 0.0f;
+    // The stretch blur's variance over this triangle per atlas axis: sigma² less what its own
+    // interpolation adds along that axis.
+    const auto variance = [&](const TriangleMap& map) {
+      return step.sigma > 0.0f ? triangle_blur_variance(x, map, static_cast<double>(step.sigma)) : glm::vec2(0.0f);
+    };
     if (!ch.wraps_x) {
-      const glm::vec2 st = triangle_stretch(x, uv);
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], face[k], t.chart, st, tri_variance});
+      const TriangleMap map = triangle_map(x, uv);
+      const glm::vec2 st = triangle_stretch(map), var = variance(map);
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], face[k], t.chart, st, var});
       continue;
     }
     const float w = static_cast<float>(ch.width);
@@ -408,12 +437,13 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
       while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
       while (uv[0].x - uv[k].x > 0.5f * w) uv[k].x += w;
     }
-    const glm::vec2 st = triangle_stretch(x, uv);
+    const TriangleMap map = triangle_map(x, uv);
+    const glm::vec2 st = triangle_stretch(map), var = variance(map);
     const float lo = std::min({uv[0].x, uv[1].x, uv[2].x}), hi = std::max({uv[0].x, uv[1].x, uv[2].x});
     for (int s = -2; s <= 2; ++s) {
       const float shift = static_cast<float>(s) * w;
       if (hi + shift <= static_cast<float>(ch.x0) || lo + shift >= static_cast<float>(ch.x0) + w) continue;
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), face[k], t.chart, st, tri_variance});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), face[k], t.chart, st, var});
     }
   }
   vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,

@@ -614,6 +614,67 @@ TEST_F(Diffuse, StretchCompensationUsesEachAxisOwnScale) {
   std::printf("sigma² %.3f: stretch-compensated variance along x %.4f, y %.4f; one width per chart %.4f, %.4f\n", s2, vx, vy, fx, fy);
 }
 
+// A long thin triangle's interpolation adds far more variance along its length than across it
+// (triangle_interpolation_variance_along: (1/12) sum_e (e · d)²): a grid of 4 × 1 rectangles
+// (cells split along a diagonal: 8/3 along x, 1/6 along y, against their mean 17/12) through an
+// isometric chart. With each axis's own share taken off, a blur of u = x² and of u = y² adds
+// sigma² along each axis within 1 % (measured 35.92 and 35.92 for 36 in one step, 35.83 and 35.83
+// in two); the triangles' mean taken off both axes (the form before) left x 1.25 over and y 1.25
+// under sigma², and each of DiffuseOptions::steps took it off again (measured 37.17 / 34.67 in one
+// step, 38.33 / 33.33 in two). Sigma 6 keeps each step's kernel (4.2) as wide as the triangles
+// are long, the regime the interpolation variance holds in (auto_steps' floor).
+TEST_F(Diffuse, EachAxisLosesItsOwnInterpolationVariance) {
+  const int n = 60;
+  const float lx = 4.0f, tpu = 2.0f;
+  Mesh m = unit_grid(n);
+  for (glm::vec3& p : m.positions) p.x *= lx;
+  const glm::vec3 t0 = m.positions[m.triangles[0][0]], t1 = m.positions[m.triangles[0][1]], t2 = m.positions[m.triangles[0][2]];
+  EXPECT_NEAR(triangle_interpolation_variance_along(t0, t1, t2, {1.0, 0.0, 0.0}), 2.0 * lx * lx / 12.0, 1e-5);
+  EXPECT_NEAR(triangle_interpolation_variance_along(t0, t1, t2, {0.0, 1.0, 0.0}), 2.0 / 12.0, 1e-6);
+  EXPECT_NEAR(triangle_interpolation_variance(t0, t1, t2), (lx * lx + 1.0 + lx * lx + 1.0) / 24.0, 1e-5);
+  AtlasMapping a;
+  a.size = 512;
+  a.gutter = 2;
+  a.charts.push_back({Chart::Kind::Joint, 2, 2, static_cast<std::uint32_t>(std::ceil((n - 1) * lx * tpu)) + 1,
+                      static_cast<std::uint32_t>(std::ceil((n - 1) * tpu)) + 1, false, tpu});
+  const auto uv = [&](glm::vec3 p) { return glm::vec2(2.5f + p.x * tpu, 2.5f + p.y * tpu); };
+  for (std::uint32_t f = 0; f < m.triangles.size(); ++f)
+    a.triangles.push_back({0, f, {uv(m.positions[m.triangles[f][0]]), uv(m.positions[m.triangles[f][1]]), uv(m.positions[m.triangles[f][2]])}});
+  a.vertex_chart.assign(m.positions.size(), 0);
+  for (const glm::vec3& p : m.positions) a.vertex_uv.push_back(uv(p));
+  const float cx = (n - 1) * lx / 2.0f, cy = (n - 1) / 2.0f, sigma = 6.0f;
+  std::vector<float> ux, uy;
+  for (const glm::vec3& p : m.positions) {
+    ux.push_back((p.x - cx) * (p.x - cx));
+    uy.push_back((p.y - cy) * (p.y - cy));
+  }
+  // The road's variance along one axis, over the vertices 4 sigma + 1 from every border.
+  const auto variance = [&](const std::vector<float>& u, std::uint32_t steps) {
+    DiffuseOptions o = sigma_of(sigma);
+    o.steps = steps;
+    const DiffuseResult r = diffuser_->run(m, a, u, o);
+    EXPECT_EQ(r.steps, steps);
+    const float margin = 4.0f * sigma + 1.0f;
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t v = 0; v < u.size(); ++v) {
+      const glm::vec3 p = m.positions[v];
+      if (p.x < margin || p.y < margin || p.x > (n - 1) * lx - margin || p.y > n - 1 - margin) continue;
+      sum += static_cast<double>(r.values[v]) - u[v];
+      ++count;
+    }
+    EXPECT_GT(count, 10);
+    return sum / std::max(count, 1);
+  };
+  const double s2 = sigma * sigma;
+  for (std::uint32_t steps : {1u, 2u}) {
+    const double vx = variance(ux, steps), vy = variance(uy, steps);
+    EXPECT_NEAR(vx, s2, 0.01 * s2) << steps << " step(s)";
+    EXPECT_NEAR(vy, s2, 0.01 * s2) << steps << " step(s)";
+    std::printf("%u step(s): variance along the long side %.4f, across %.4f, sigma² %.4f\n", steps, vx, vy, s2);
+  }
+}
+
 // The raster pass writes the per-texel stretch (a second colour attachment, its copy, and the
 // blur's prefix sums) only for the stretch-compensated blur: a radius in texels, a sigma with the
 // compensation off and no blur at all declare none of it in the graph, while the same values

@@ -41,6 +41,8 @@
 #include "sdfkit/core/mesh.hpp"
 #include "sdfkit/diffusion/atlas.hpp"
 
+#include <glm/vec3.hpp>
+
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -148,6 +150,15 @@ double interpolation_variance(const Mesh& mesh);
 // (a CAD part: long flat-face triangles beside fine fillets) the mesh's mean can reach sigma² at
 // sigma = 1 mean edge and leave the fine parts unblurred.
 double triangle_interpolation_variance(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
+// The same along one direction d of the triangle's plane (unit length): the tensor form of the
+// derivation above, sum_j φ_j(x) (x_j - x)(x_j - x)ᵀ, has the mean (1/12) sum_e e eᵀ over the
+// triangle, so interpolation adds (1/12) sum_e (e · d)² along d; its mean over two orthogonal
+// directions of the plane is triangle_interpolation_variance. A long thin triangle adds far more
+// along its length than across it (legs 4 and 1: 8/3 against 1/6); the stretch-compensated blur
+// takes each atlas axis's own off (its surface direction: the map's Jacobian column), so a mesh
+// of anisotropic triangles (tubes, extrusions) gets sigma² on both axes, not sigma² plus and
+// minus their difference, an error that grew with DiffuseOptions::steps (each step took it off again).
+double triangle_interpolation_variance_along(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::dvec3& d);
 // Per chart of `mapping`: the area-weighted mean of triangle_interpolation_variance over its atlas
 // triangles (own and band); the mesh's for a chart without area.
 std::vector<double> chart_interpolation_variance(const Mesh& mesh, const AtlasMapping& mapping);
