@@ -421,24 +421,21 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     const auto& face = mesh.triangles[t.face];
     glm::vec2 uv[3] = {t.uv[0], t.uv[1], t.uv[2]};
     const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
-    // The stretch blur's variance over this triangle per atlas axis: sigma² less what its own
-    // interpolation adds along that axis.
-    const auto variance = [&](const TriangleMap& map) {
-      return step.sigma > 0.0f ? triangle_blur_variance(x, map, static_cast<double>(step.sigma)) : glm::vec2(0.0f);
-    };
+    const float w = static_cast<float>(ch.width);
+    if (ch.wraps_x)
+      for (int k = 1; k < 3; ++k) {
+        while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
+        while (uv[0].x - uv[k].x > 0.5f * w) uv[k].x += w;
+      }
+    // The map's stretch, and the stretch blur's variance over this triangle per atlas axis:
+    // sigma² less what its own interpolation adds along that axis.
+    const TriangleMap map = triangle_map(x, uv);
+    const glm::vec2 st = triangle_stretch(map);
+    const glm::vec2 var = step.sigma > 0.0f ? triangle_blur_variance(x, map, static_cast<double>(step.sigma)) : glm::vec2(0.0f);
     if (!ch.wraps_x) {
-      const TriangleMap map = triangle_map(x, uv);
-      const glm::vec2 st = triangle_stretch(map), var = variance(map);
       for (int k = 0; k < 3; ++k) soup.push_back({uv[k], face[k], t.chart, st, var});
       continue;
     }
-    const float w = static_cast<float>(ch.width);
-    for (int k = 1; k < 3; ++k) {
-      while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
-      while (uv[0].x - uv[k].x > 0.5f * w) uv[k].x += w;
-    }
-    const TriangleMap map = triangle_map(x, uv);
-    const glm::vec2 st = triangle_stretch(map), var = variance(map);
     const float lo = std::min({uv[0].x, uv[1].x, uv[2].x}), hi = std::max({uv[0].x, uv[1].x, uv[2].x});
     for (int s = -2; s <= 2; ++s) {
       const float shift = static_cast<float>(s) * w;

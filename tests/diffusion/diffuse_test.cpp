@@ -62,19 +62,24 @@ Mesh unit_grid(int n) {
   return m;
 }
 
-// The mean of out - u over the vertices of unit_grid(n) at least `margin` from its border: what a
-// blur added to a quadratic u there (its variance along each axis u grows in).
-double interior_gain(const Mesh& m, int n, float margin, const std::vector<float>& out, const std::vector<float>& u) {
+// The mean of out - u over the vertices of a grid spanning [0, extent.x] × [0, extent.y] at least
+// `margin` from its border: what a blur added to a quadratic u there (its variance along each
+// axis u grows in).
+double interior_gain(const Mesh& m, glm::vec2 extent, float margin, const std::vector<float>& out, const std::vector<float>& u) {
   double sum = 0.0;
   int count = 0;
   for (std::size_t v = 0; v < u.size(); ++v) {
     const glm::vec3 p = m.positions[v];
-    if (p.x < margin || p.y < margin || p.x > n - 1 - margin || p.y > n - 1 - margin) continue;
+    if (p.x < margin || p.y < margin || p.x > extent.x - margin || p.y > extent.y - margin) continue;
     sum += static_cast<double>(out[v]) - u[v];
     ++count;
   }
   EXPECT_GT(count, 50);
   return sum / std::max(count, 1);
+}
+// The same over unit_grid(n).
+double interior_gain(const Mesh& m, int n, float margin, const std::vector<float>& out, const std::vector<float>& u) {
+  return interior_gain(m, glm::vec2(static_cast<float>(n - 1)), margin, out, u);
 }
 
 DiffuseOptions sigma_of(float sigma, bool keep_atlas = false) {
@@ -654,17 +659,7 @@ TEST_F(Diffuse, EachAxisLosesItsOwnInterpolationVariance) {
     o.steps = steps;
     const DiffuseResult r = diffuser_->run(m, a, u, o);
     EXPECT_EQ(r.steps, steps);
-    const float margin = 4.0f * sigma + 1.0f;
-    double sum = 0.0;
-    int count = 0;
-    for (std::size_t v = 0; v < u.size(); ++v) {
-      const glm::vec3 p = m.positions[v];
-      if (p.x < margin || p.y < margin || p.x > (n - 1) * lx - margin || p.y > n - 1 - margin) continue;
-      sum += static_cast<double>(r.values[v]) - u[v];
-      ++count;
-    }
-    EXPECT_GT(count, 10);
-    return sum / std::max(count, 1);
+    return interior_gain(m, glm::vec2((n - 1) * lx, n - 1.0f), 4.0f * sigma + 1.0f, r.values, u);
   };
   const double s2 = sigma * sigma;
   for (std::uint32_t steps : {1u, 2u}) {
