@@ -148,9 +148,10 @@ struct SkeletonOptions {
   // Place each curve node at the centre of the part of the solid its vertices enclose (the mean
   // of their SDF centre points u - SDF/2 n); off = the contracted position (if inside).
   bool refine_embedding = true;
-  // Give each curve leaf a tip node at the centre point of its vertex farthest along the limb
-  // (when that lies over a node radius beyond the leaf, inside the solid): leaves reach the
-  // ends of limbs instead of stopping at the centre of the last node's region. Before that, a
+  // Give each curve leaf a tip node when the centre point of its vertex farthest along the limb
+  // lies over a node radius beyond the leaf, inside the solid: the node takes the leaf's
+  // vertices beyond the midpoint and sits at their centre, so leaves reach the ends of limbs
+  // instead of stopping at the centre of the last node's region. Before that, a
   // leaf hanging off a degree-2 node, inside the tube of the edge that node continues on (a knee
   // hanging off the foot), is threaded into that edge, so the farther node becomes the leaf.
   bool extend_leaves = true;
