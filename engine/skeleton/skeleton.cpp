@@ -1354,8 +1354,11 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // not its end (s11leaves): the surgery can join a hip straight to the foot and leave the
   // knee's node hanging off the foot. Where a curve leaf L hangs from a degree-2 curve node F
   // whose other neighbour is H, L projects strictly between H and F, lies within the tube of
-  // HF (the ends' radii interpolated) and the segment HL is inside, the curve runs H-L-F and F,
-  // the farther node, becomes the leaf. Leaf count, junctions and cycles are unchanged.
+  // HF (the ends' radii interpolated) or HF passes through L's own ball (a bent knee lies off
+  // the hip-foot chord by more than the thinner foot's radius gives, but within its own: homer's
+  // right knee, 0.064 from the chord, tube 0.062, its radius 0.068), and the segment HL is
+  // inside, the curve runs H-L-F and F, the farther node, becomes the leaf. Leaf count,
+  // junctions and cycles are unchanged.
   if (options.extend_leaves) {
     std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
     for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
@@ -1371,7 +1374,8 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       const float t = glm::dot(p - a, b - a) / len2;
       if (!(t > 0.0f && t < 1.0f)) continue;
       const float tube = (1.0f - t) * sk.nodes[h].radius + t * sk.nodes[f].radius;
-      if (glm::length(p - (a + t * (b - a))) >= tube || surface.bvh.segment_blocked(a, p)) continue;
+      const float reach = std::max(tube, sk.nodes[leaf].radius);
+      if (glm::length(p - (a + t * (b - a))) >= reach || surface.bvh.segment_blocked(a, p)) continue;
       edges.erase({std::min(h, f), std::max(h, f)});
       add_edge(h, leaf);
       adjacency[f] = {leaf};
