@@ -29,7 +29,7 @@ void main() {
   const uvec2 p = uvec2(gl_FragCoord.xy);
   if (p.x < r.x || p.y < r.y || p.x >= r.x + r.z || p.y >= r.y + r.w) discard;
   // Within the triangle's corner values: interpolation never leaves them, extrapolation at the
-  // texels a sliver's snapped corners cover outside it does (RasterVertex::corners).
+  // texels a sliver's snapped corners cover outside it does (glsl/atlas_raster.vert).
   out_texel = vec2(clamp(in_value, in_range.x, in_range.y), 1.0);
 #ifndef ATLAS_RASTER_VALUE_ONLY
   out_half_width = vec2(stretch_half_width(in_stretch.x, in_variance.x), stretch_half_width(in_stretch.y, in_variance.y));

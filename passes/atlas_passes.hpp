@@ -40,18 +40,8 @@ struct RasterVertex {
   // long thin triangle's two directions, each get what they lack of sigma². 0 for a blur of one
   // width in texels (unused there).
   glm::vec2 variance;
-  // The triangle's three mesh vertices (the same in its three corners): the fragment stage clamps
-  // the interpolated value to the range of their values. The rasterizer decides coverage on
-  // corners snapped to its sub-texel grid, so a sliver (a rim triangle seen edge-on by a chart)
-  // covers texel centres outside the triangle itself, where its plane equation extrapolates with
-  // a gradient as steep as the sliver is thin (cheese: -14 and 107 in a field of 0.4 to 1.7).
-  // A linear interpolant inside its triangle never leaves its corners' range, so the clamp only
-  // undoes the extrapolation, and every texel stays within the field's range (the maximum
-  // principle the blur, a positive normalized filter, then keeps).
-  glm::uvec3 corners;
-  std::uint32_t pad = 0;
 };
-static_assert(sizeof(RasterVertex) == 48);
+static_assert(sizeof(RasterVertex) == 32);
 
 // One read of a vertex's value (atlas_sample.comp): AtlasMapping's VertexSample.
 struct SampleQuery {

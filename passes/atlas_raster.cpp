@@ -19,12 +19,13 @@ AtlasRasterOutput add_atlas_raster_pass(vk::RenderGraph& graph, const AtlasRaste
       with_stretch ? raster.color(in.stretch_target, vk::LoadOp::Clear, VkClearColorValue{{-1.0f, -1.0f, 0.0f, 0.0f}})
                    : vk::ImageHandle{};
   raster.vertex(in.vertices);
+  raster.storage_read(in.vertices);  // the provoking corner reads its triangle's other two there
   raster.storage_read(in.values);
   raster.storage_read(in.charts);
   raster.execute([in](vk::PassContext& pc) {
     if (in.vertex_count == 0) return;
     vkCmdBindPipeline(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, in.pipeline->get());
-    const VkDescriptorSet set = pc.descriptor_set(in.pipeline->set_layout.get(), {{0, in.charts}, {1, in.values}});
+    const VkDescriptorSet set = pc.descriptor_set(in.pipeline->set_layout.get(), {{0, in.charts}, {1, in.values}, {2, in.vertices}});
     vkCmdBindDescriptorSets(pc.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, in.pipeline->layout.get(), 0, 1, &set, 0, nullptr);
     const VkBuffer b = pc.buffer(in.vertices);
     const VkDeviceSize offset = 0;

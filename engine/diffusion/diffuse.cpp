@@ -39,14 +39,15 @@ vk::Pipeline make_raster_pipeline(vk::Context& ctx, bool with_stretch) {
   vk::GraphicsPipelineDescription d;
   d.vertex_shader = "atlas_raster.vert";
   d.fragment_shader = with_stretch ? "atlas_raster.frag" : "atlas_raster_value.frag";
-  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};  // charts, vertex values
+  // charts, vertex values, and the triangle soup itself (the provoking corner reads its triangle's
+  // three mesh vertices there, atlas_raster.vert)
+  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
   d.push_bytes = sizeof(passes::RasterPush);
   d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, uv)},
                   {1, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, vertex)},
                   {2, 0, VK_FORMAT_R32_UINT, offsetof(passes::RasterVertex, chart)},
                   {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, stretch)},
-                  {4, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, variance)},
-                  {5, 0, VK_FORMAT_R32G32B32_UINT, offsetof(passes::RasterVertex, corners)}};
+                  {4, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(passes::RasterVertex, variance)}};
   d.vertex_stride = sizeof(passes::RasterVertex);
   d.color_formats = {kRasterFormat};  // (value, coverage)
   if (with_stretch) d.color_formats.push_back(kRasterFormat);  // the half-widths
@@ -422,7 +423,6 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     const auto& face = mesh.triangles[t.face];
     glm::vec2 uv[3] = {t.uv[0], t.uv[1], t.uv[2]};
     const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
-    const glm::uvec3 corners(face[0], face[1], face[2]);
     const float w = static_cast<float>(ch.width);
     if (ch.wraps_x)
       for (int k = 1; k < 3; ++k) {
@@ -435,17 +435,18 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
     const glm::vec2 st = triangle_stretch(map);
     const glm::vec2 var = step.sigma > 0.0f ? triangle_blur_variance(x, map, static_cast<double>(step.sigma)) : glm::vec2(0.0f);
     if (!ch.wraps_x) {
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], face[k], t.chart, st, var, corners});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], face[k], t.chart, st, var});
       continue;
     }
     const float lo = std::min({uv[0].x, uv[1].x, uv[2].x}), hi = std::max({uv[0].x, uv[1].x, uv[2].x});
     for (int s = -2; s <= 2; ++s) {
       const float shift = static_cast<float>(s) * w;
       if (hi + shift <= static_cast<float>(ch.x0) || lo + shift >= static_cast<float>(ch.x0) + w) continue;
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), face[k], t.chart, st, var, corners});
+      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), face[k], t.chart, st, var});
     }
   }
-  vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+  vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex),
+                                    VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                     vk::MemoryUse::Upload);
   if (!soup.empty()) std::memcpy(soup_buf.mapped(), soup.data(), soup.size() * sizeof(passes::RasterVertex));
 

@@ -956,7 +956,7 @@ TEST_F(Diffuse, StepsCarryTheKernelRoundAPartSmallerThanIt) {
 // steep as the sliver is thin. 400 slivers 0.005 texel thin and 10 to 40 long in random
 // directions, their long edge's corners at 0 and the opposite corner at 1: every texel of the
 // atlas and every vertex read back lies in [0, 1]. Without the raster's clamp to each triangle's
-// corner values (RasterVertex::corners): texels and vertices down to -0.18.
+// corner values (glsl/atlas_raster.vert): texels and vertices down to -0.18.
 TEST_F(Diffuse, SliversStayWithinTheirCornerValues) {
   Mesh m;
   AtlasMapping a;
