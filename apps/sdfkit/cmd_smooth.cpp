@@ -124,7 +124,11 @@ void add_smooth_command(CLI::App& app) {
       for (const char* k : {"--radius", "--steps", "--atlas-size", "--atlas-png", "--skeleton", "--device"})
         if (given(k)) throw UsageError(std::string(k) + " needs --texture-space");
     }
+    // An output that cannot hold the values is refused before the work, not after it: the
+    // extension before loading, per-face values to glTF once the result says what it holds.
+    io::check_output(a->output, SdfDomain::Vertex);
     const ResultValues r = load_or_compute(a->input, nullptr, a->load);
+    io::check_output(a->output, r.domain);
     if (a->texture) {
 #ifdef SDFKIT_CLI_HAS_RENDER
       if (r.domain != SdfDomain::Vertex)

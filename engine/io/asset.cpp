@@ -191,9 +191,8 @@ void append_fan(std::vector<Triangle>& triangles, const std::uint32_t* corners, 
 
 }  // namespace detail
 
-Format format_from_path(const std::string& path) {
-  const std::string ext_raw = std::filesystem::path(path).extension().string();
-  std::string ext = ext_raw;
+std::optional<Format> format_of_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
   if (ext == ".gltf") return Format::Gltf;
@@ -202,9 +201,14 @@ Format format_from_path(const std::string& path) {
   if (ext == ".off") return Format::Off;
   if (ext == ".ply") return Format::Ply;
   if (ext == ".txt") return Format::Txt;
+  return std::nullopt;
+}
+
+Format format_from_path(const std::string& path) {
+  if (const std::optional<Format> f = format_of_extension(path)) return *f;
+  const std::string ext = std::filesystem::path(path).extension().string();
   if (ext.empty()) detail::fail(path, "no file extension (expected .gltf, .glb, .obj, .off, .ply)");
-  detail::fail(path,
-               "unknown extension '" + ext_raw + "' (expected .gltf, .glb, .obj, .off, .ply)");
+  detail::fail(path, "unknown extension '" + ext + "' (expected .gltf, .glb, .obj, .off, .ply)");
 }
 
 const char* format_name(Format format) {

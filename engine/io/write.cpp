@@ -194,12 +194,18 @@ void write_ply(std::ostream& out, std::span<const glm::vec3> positions, std::spa
 }  // namespace detail
 
 void check_output(const std::string& out_path, SdfDomain domain) {
-  const Format format = format_from_path(out_path);
+  const std::optional<Format> named = format_of_extension(out_path);
+  if (!named || *named == Format::Obj || *named == Format::Off) {
+    const std::string ext = std::filesystem::path(out_path).extension().string();
+    throw InputError(out_path + ": " +
+                     (ext.empty() ? std::string("no file extension")
+                      : named     ? "cannot store values in " + ext + " files"
+                                  : "unknown extension '" + ext + "'") +
+                     "; write .gltf, .glb, .ply or .txt");
+  }
+  const Format format = *named;
   if ((format == Format::Gltf || format == Format::Glb) && domain != SdfDomain::Vertex)
     throw InputError(out_path + ": per-face values cannot be stored in glTF; write .ply or .txt");
-  if (format == Format::Obj || format == Format::Off)
-    throw InputError(out_path + ": cannot store values in ." + format_name(format) +
-                     " files; write .gltf, .glb, .ply or .txt");
 }
 
 void write_field(const std::string& out_path, const Asset& asset, const SdfField& field,

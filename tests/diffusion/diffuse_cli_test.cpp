@@ -27,14 +27,30 @@ const std::string kCli = SDFKIT_CLI;
 
 // A capped cylinder (radius 1, length 6) as OFF and a field on it as .txt: a step at mid-length,
 // a slope along the axis and waves around it.
+float cylinder_field(const glm::vec3& p) {
+  return 2.0f + 0.4f * std::sin(3.0f * std::atan2(p.y, p.x)) + 0.3f * p.z + (p.z > 0.0f ? 0.5f : 0.0f);
+}
+Mesh cylinder() { return shapes::capped_cylinder(1.0f, 6.0f, 64, 60, 8); }
+
 void write_cylinder_and_field(const std::string& off, const std::string& txt) {
-  const Mesh m = shapes::capped_cylinder(1.0f, 6.0f, 64, 60, 8);
+  const Mesh m = cylinder();
   std::ofstream o(off), t(txt);
   o << "OFF\n" << m.vertex_count() << " " << m.face_count() << " 0\n";
   for (const glm::vec3& p : m.positions) {
     o << p.x << " " << p.y << " " << p.z << "\n";
-    t << 2.0f + 0.4f * std::sin(3.0f * std::atan2(p.y, p.x)) + 0.3f * p.z + (p.z > 0.0f ? 0.5f : 0.0f) << "\n";
+    t << cylinder_field(p) << "\n";
   }
+  for (const auto& f : m.triangles) o << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
+}
+
+// The same as one result file: an ASCII PLY with the field as vertex quality.
+void write_cylinder_result(const std::string& ply) {
+  const Mesh m = cylinder();
+  std::ofstream o(ply);
+  o << "ply\nformat ascii 1.0\nelement vertex " << m.vertex_count()
+    << "\nproperty float x\nproperty float y\nproperty float z\nproperty float quality\nelement face "
+    << m.face_count() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const glm::vec3& p : m.positions) o << p.x << " " << p.y << " " << p.z << " " << cylinder_field(p) << "\n";
   for (const auto& f : m.triangles) o << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
 }
 
@@ -116,6 +132,30 @@ TEST(DiffuseCli, UsageErrorsExitTwo) {
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_FALSE(std::filesystem::exists(out));
   }
+}
+
+// An output that cannot hold the values is the error, before any work: with a Vulkan device that
+// does not exist, the device would be the error had the diffusion started first. Nothing written.
+TEST(DiffuseCli, AnOutputThatCannotHoldTheValuesIsRefusedBeforeTheWork) {
+  ScratchDir dir;
+  const std::string ply = dir.path("cyl.ply");
+  write_cylinder_result(ply);
+  CommandResult r = run_command(kCli + " smooth " + ply + " -o " + dir.path("ok.txt") + " -k 1 -q", dir.dir());
+  ASSERT_EQ(r.exit_code, 0) << r.err;  // the result file itself is good
+  const std::pair<const char*, const char*> cases[] = {
+      {"out.xyz", "unknown extension '.xyz'; write .gltf, .glb, .ply or .txt"},
+      {"out.off", "cannot store values in .off files"},
+      {"out", "no file extension"}};
+  for (const auto& [name, what] : cases)
+    for (const std::string mode : {"--texture-space --radius 2 --device no-such-device", "-k 2"}) {
+      const std::string out = dir.path(name);
+      r = run_command(kCli + " smooth " + ply + " -o " + out + " " + mode, dir.dir());
+      EXPECT_EQ(r.exit_code, 1) << name << " " << mode << ": " << r.err;
+      EXPECT_EQ(r.err.rfind("sdfkit: error: " + out + ": ", 0), 0u) << r.err;
+      EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_FALSE(std::filesystem::exists(out)) << out;
+    }
 }
 
 TEST(DiffuseCli, SmoothTextureSpaceWritesTheResultAndTheAtlas) {

@@ -268,6 +268,18 @@ TEST(WriteField, MismatchedFieldAndUnsupportedFormatsAreErrors) {
   const std::string off = dir.path("values.off");
   test::expect_input_error([&] { io::write_field(off, a, ramp_field(a, SdfDomain::Vertex)); }, off,
                            "cannot store values in .off");
+  // An output's formats, not a mesh's: .txt is one, .obj and .off are not.
+  for (const char* name : {"values.xyz", "values"}) {
+    const std::string bad = dir.path(name);
+    test::expect_input_error([&] { io::check_output(bad, SdfDomain::Vertex); }, bad,
+                             "; write .gltf, .glb, .ply or .txt");
+    EXPECT_FALSE(std::filesystem::exists(bad));
+  }
+  test::expect_input_error([&] { io::check_output(dir.path("v.xyz"), SdfDomain::Vertex); }, dir.path("v.xyz"),
+                           "unknown extension '.xyz'");
+  test::expect_input_error([&] { io::check_output(dir.path("v"), SdfDomain::Vertex); }, dir.path("v"),
+                           "no file extension");
+  EXPECT_NO_THROW(io::check_output(dir.path("v.TXT"), SdfDomain::Face));
 }
 
 // --- PLY --------------------------------------------------------------------------------

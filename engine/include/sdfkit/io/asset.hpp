@@ -17,6 +17,7 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -29,6 +30,10 @@ enum class Format { Gltf, Glb, Obj, Off, Ply, Txt };
 // .txt). Throws InputError "<path>: unknown extension '.xyz' (expected .gltf, .glb, .obj, .off,
 // .ply)" otherwise. .txt is an output-only format: load_asset rejects it.
 Format format_from_path(const std::string& path);
+
+// The format named by the path's extension (case-insensitive), or nothing: what a caller with its
+// own list of formats (an output's) checks before format_from_path's message.
+std::optional<Format> format_of_extension(const std::string& path);
 
 // Lower-case name of a format ("gltf", "off", ...).
 const char* format_name(Format format);
