@@ -1837,6 +1837,41 @@ Skeleton extract_manifold(const Mesh& mesh, SdfBackend* backend, const Contracti
 Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
                  const SkeletonOptions& options) {
   validate(options);
+  // Vertices no triangle uses are left out: the skeleton is the surface's, and such a vertex would
+  // stay where it is through the contraction (no Laplacian row), become a node of its own outside
+  // the solid, and stretch the bounding box the skeleton's scales come from.
+  const std::size_t n_in = mesh.positions.size();
+  std::vector<std::uint32_t> used(n_in, 0);
+  bool in_range = true;  // else the checks below report the bad index
+  for (const Triangle& t : mesh.triangles)
+    for (std::uint32_t v : t)
+      if (v < n_in) used[v] = 1;
+      else in_range = false;
+  const auto n_used = static_cast<std::size_t>(std::count(used.begin(), used.end(), 1u));
+  if (in_range && n_used < n_in && n_used > 0) {
+    Mesh surface;
+    std::vector<std::uint32_t> kept;  // surface vertex -> input vertex
+    kept.reserve(n_used);
+    for (std::uint32_t v = 0; v < n_in; ++v)
+      if (used[v]) used[v] = static_cast<std::uint32_t>(kept.size()) + 1, kept.push_back(v);  // 1-based index
+    surface.positions.reserve(n_used);
+    for (std::uint32_t v : kept) surface.positions.push_back(mesh.positions[v]);
+    surface.triangles.reserve(mesh.triangles.size());
+    for (const Triangle& t : mesh.triangles) surface.triangles.push_back({used[t[0]] - 1, used[t[1]] - 1, used[t[2]] - 1});
+    Skeleton sk = extract(surface, backend, contraction, options);
+    for (Node& node : sk.nodes)
+      for (std::uint32_t& v : node.vertices) v = kept[v];
+    if (!sk.sdf.empty()) {
+      std::vector<float> sdf(n_in, 0.0f);
+      for (std::size_t k = 0; k < kept.size(); ++k) sdf[kept[k]] = sk.sdf[k];
+      sk.sdf = std::move(sdf);
+    }
+    const std::size_t left = n_in - n_used;
+    sk.warnings.insert(sk.warnings.begin(), std::to_string(left) +
+                                                (left == 1 ? " vertex no triangle uses is" : " vertices no triangle uses are") +
+                                                " left out of the skeleton");
+    return sk;
+  }
   // A closed mesh with non-manifold edges (parts touching along an edge) is split there into
   // closed edge-manifold surfaces; the skeleton is built for that mesh and its vertex indices
   // are mapped back to the input's (the copies come after the input's vertices).

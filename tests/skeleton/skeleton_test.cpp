@@ -236,6 +236,37 @@ TEST(Skeleton, SeveralComponentsGiveOnePartEach) {
     EXPECT_EQ(s.nodes[e[0]].vertices.front() < offset, s.nodes[e[1]].vertices.front() < offset);
 }
 
+// Vertices no triangle uses (one before the surface's, one after) are not the surface's: the
+// skeleton is the one of the surface alone, node for node, with the vertex indices shifted; they
+// belong to no node and their SDF is 0. Before, each became a node of its own outside the solid,
+// and the far one stretched the bounding box the skeleton's scales come from.
+TEST(Skeleton, VerticesNoTriangleUsesAreLeftOut) {
+  const Mesh surface = shapes::capsule(0.5f, 3.0f, 16, 12);
+  Mesh padded;
+  padded.positions.push_back({20.0f, 20.0f, 20.0f});
+  padded.positions.insert(padded.positions.end(), surface.positions.begin(), surface.positions.end());
+  padded.positions.push_back({-30.0f, 0.0f, 0.0f});
+  for (Triangle t : surface.triangles) padded.triangles.push_back({t[0] + 1, t[1] + 1, t[2] + 1});
+  const sk::Skeleton a = run(surface, true, true), b = run(padded, true, true);
+  ASSERT_EQ(b.nodes.size(), a.nodes.size());
+  for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+    EXPECT_EQ(b.nodes[i].position, a.nodes[i].position) << i;
+    EXPECT_EQ(b.nodes[i].radius, a.nodes[i].radius) << i;
+    ASSERT_EQ(b.nodes[i].vertices.size(), a.nodes[i].vertices.size()) << i;
+    for (std::size_t k = 0; k < a.nodes[i].vertices.size(); ++k)
+      EXPECT_EQ(b.nodes[i].vertices[k], a.nodes[i].vertices[k] + 1) << i;
+  }
+  EXPECT_EQ(b.edges, a.edges);
+  EXPECT_EQ(b.sheet_triangles.size(), a.sheet_triangles.size());
+  ASSERT_EQ(b.sdf.size(), padded.positions.size());
+  EXPECT_EQ(b.sdf.front(), 0.0f);
+  EXPECT_EQ(b.sdf.back(), 0.0f);
+  for (std::size_t v = 0; v < a.sdf.size(); ++v) EXPECT_EQ(b.sdf[v + 1], a.sdf[v]) << v;
+  ASSERT_FALSE(b.warnings.empty());
+  EXPECT_NE(b.warnings.front().find("2 vertices no triangle uses"), std::string::npos) << b.warnings.front();
+  expect_partition_and_inside(surface, a);
+}
+
 // cycle_count is the first Betti number of curves plus sheets: a closed sheet (a tetrahedron's
 // surface) encloses a void and adds no cycle, a disc adds none, a ring of curve edges or a curve
 // edge across a sheet's open wedge adds one.

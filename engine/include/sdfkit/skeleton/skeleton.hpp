@@ -175,7 +175,7 @@ struct SkeletonOptions {
 struct Node {
   glm::vec3 position{0.0f};
   float radius = 0.0f;                  // local radius in model units (SDF/2 of its vertices)
-  std::vector<std::uint32_t> vertices;  // input-mesh vertices this node represents
+  std::vector<std::uint32_t> vertices;  // input-mesh vertices this node represents (see extract())
   bool sheet = false;                   // node of a sheet (a cluster of the contracted sheet)
 };
 
@@ -212,8 +212,10 @@ struct Skeleton {
 // no centering term, radii are the mean distance from a node to its vertices, grouping uses the
 // distance from a vertex to its contracted position, centre points come from one ray along the
 // inward normal). With a backend and sdf_term off, the SDF is computed once (radii, grouping,
-// centre points) but not used in the contraction. Every input vertex belongs to exactly one
-// node; every node lies inside the solid.
+// centre points) but not used in the contraction. Every vertex a triangle uses belongs to exactly
+// one node; every node lies inside the solid. Vertices no triangle uses (glTF, OBJ and PLY allow
+// them) are not part of the surface: they belong to no node, take no part in the contraction or
+// in the scales taken from the bounding box, and their Skeleton::sdf is 0 (a warning counts them).
 Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
                  const SkeletonOptions& options);
 
