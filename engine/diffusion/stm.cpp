@@ -160,7 +160,7 @@ struct ChartMap {
   double angle0 = 0;            // Bone: the angle at x = 0
   bool wraps = true;            // Bone: the piece goes all around (else x spans the used sector)
   glm::dvec3 origin{0.0}, axis{0.0}, b1{0.0}, b2{0.0};  // Cap / planar
-  double cap_radius = 0;        // Cap: ρ = polar angle × cap_radius
+  double cap_radius = 0;        // Cap: ρ = 2 tan(polar angle / 2) × cap_radius (stereographic)
   bool cap = false;
   // Local extent (after collection), model units.
   glm::dvec2 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
@@ -182,7 +182,13 @@ glm::dvec2 local_coords(const ChartMap& c, const std::vector<Bone>& bones, const
     const glm::dvec2 dir(glm::dot(q, c.b1), glm::dot(q, c.b2));
     const double dl = glm::length(dir);
     if (dl <= 0) return {0, 0};
-    return dir / dl * (polar * c.cap_radius);
+    // Stereographic: the conformal map of the sphere of directions around the origin (the
+    // azimuthal equidistant map, ρ = polar × cap_radius, is not). The blur follows a conformal
+    // map's Laplace-Beltrami operator, λ⁻² Δ, with its per-texel width alone; a non-conformal map
+    // adds a drift term (Δ of the chart's coordinates) that no blur width carries. On a unit
+    // sphere, six cap charts, u = z (exact answer z e^(-σ²)), read from their own charts: RMS error
+    // 16-20 % of the change at 1-5 edges with the equidistant map, 0.1-0.4 % with this one.
+    return dir / dl * (2.0 * std::tan(0.5 * polar) * c.cap_radius);
   }
   return {glm::dot(q, c.b1), glm::dot(q, c.b2)};
 }
@@ -757,7 +763,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       m.b2 = glm::cross(m.axis, m.b1);
     }
   }
-  // With an overlap band, a planar chart becomes an azimuthal equidistant map (the end caps' map)
+  // With an overlap band, a planar chart becomes an azimuthal (stereographic) map (the end caps' map)
   // around the mean of its vertices' skeleton nodes, which lie inside the solid: a surface around
   // the skeleton is seen from there without folding until the far side, where an orthographic
   // projection folds at 90° from its axis, so the band reaches round a limb or a junction instead of

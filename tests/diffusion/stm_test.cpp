@@ -78,13 +78,16 @@ TEST(Stm, CapsuleIsOneIsometricBoneChartAndTwoCaps) {
   EXPECT_NEAR(bone->angle_distortion.max, 1.0, 0.005);
   // The cylinder's side area 2π r L, all in the bone chart (its triangles only).
   EXPECT_NEAR(bone->area, 2 * M_PI * kRadius * kLength, 0.01 * 2 * M_PI * kRadius * kLength);
-  // Caps: azimuthal equidistant projection of a hemisphere; its area distortion is θ/sin θ,
-  // at most π/2 at the rim, and the angle distortion the same.
+  // Caps: stereographic projection of the directions around the hemisphere's centre, conformal
+  // on the smooth hemisphere (measured here: 1.06 on the flat facets and whatever cylinder
+  // triangles the cap chart holds; the equidistant map's angle distortion reached π/2 at the rim),
+  // with the scale 1 / cos²(θ/2): area distortion from 1 at the pole to 1 / cos⁴(45°) = 4 at the
+  // rim.
   for (const dif::ChartQuality& c : stm.quality.charts) {
     if (c.kind != dif::Chart::Kind::Joint) continue;
-    EXPECT_LE(c.area_distortion.max, M_PI / 2 * 1.05);
+    EXPECT_LE(c.area_distortion.max, 4.0 * 1.05);
     EXPECT_GE(c.area_distortion.mean, 0.95);
-    EXPECT_LE(c.angle_distortion.max, M_PI / 2 * 1.05);
+    EXPECT_LE(c.angle_distortion.max, 1.1);
   }
   EXPECT_GT(stm.quality.atlas_used, 0.3) << "the shelf packing of three rectangles";
   EXPECT_LT(stm.quality.overlap, 1e-3) << "no chart folds over itself";

@@ -14,7 +14,7 @@
 //    piece of a bone's region that leaves over a quarter turn unused: its x spans the used
 //    sector. A bone region cut in pieces (by the demotions below) is one chart per piece;
 //    pieces under 12 vertices go to planar joint charts.
-//  - Joint: at a leaf (end cap: azimuthal equidistant projection around the bone's direction)
+//  - Joint: at a leaf (end cap: stereographic projection of the directions around the bone's direction)
 //    and, as planar projections, at junctions and wherever a bone chart would fold (closest point
 //    at a segment's end, surface normal along the bone, vertex on the polyline, a stretched or
 //    flipped triangle).
