@@ -197,7 +197,7 @@ void check_output(const std::string& out_path, SdfDomain domain) {
   const std::optional<Format> named = format_of_extension(out_path);
   if (!named || *named == Format::Obj || *named == Format::Off) {
     const std::string ext = std::filesystem::path(out_path).extension().string();
-    throw InputError(out_path + ": " +
+    throw UsageError(out_path + ": " +
                      (ext.empty() ? std::string("no file extension")
                       : named     ? "cannot store values in " + ext + " files"
                                   : "unknown extension '" + ext + "'") +
@@ -205,7 +205,7 @@ void check_output(const std::string& out_path, SdfDomain domain) {
   }
   const Format format = *named;
   if ((format == Format::Gltf || format == Format::Glb) && domain != SdfDomain::Vertex)
-    throw InputError(out_path + ": per-face values cannot be stored in glTF; write .ply or .txt");
+    throw UsageError(out_path + ": per-face values cannot be stored in glTF; write .ply or .txt");
 }
 
 void write_field(const std::string& out_path, const Asset& asset, const SdfField& field,

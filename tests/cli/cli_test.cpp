@@ -152,9 +152,17 @@ TEST_F(Cli, BadOptionValuesAreUsageErrors) {
 
 TEST_F(Cli, AnUnwritableOutputIsReportedBeforeAnyDeviceIsOpened) {
   // No device matches "no-such-device": had the device been opened first, that would be the error.
-  for (const char* out : {"x.off", "x.obj"})
-    expect_clean_error(run("compute builtin:sphere -o " + (dir_ / out).string() + " --device no-such-device"), out);
-  expect_clean_error(run("compute builtin:sphere --per face -o " + (dir_ / "x.glb").string() +
+  // An output that cannot hold the values is a usage error (exit 2), as an unknown option is.
+  const auto expect_usage_error = [](const RunResult& r, const std::string& what) {
+    EXPECT_FALSE(r.signaled) << r.err;
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("sdfkit: usage error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+  };
+  for (const char* out : {"x.off", "x.obj", "x.xyz"})
+    expect_usage_error(run("compute builtin:sphere -o " + (dir_ / out).string() + " --device no-such-device"), out);
+  expect_usage_error(run("compute builtin:sphere --per face -o " + (dir_ / "x.glb").string() +
                          " --device no-such-device"),
                      "per-face values cannot be stored in glTF");
   EXPECT_FALSE(fs::exists(dir_ / "x.off"));

@@ -150,8 +150,8 @@ TEST(DiffuseCli, AnOutputThatCannotHoldTheValuesIsRefusedBeforeTheWork) {
     for (const std::string mode : {"--texture-space --radius 2 --device no-such-device", "-k 2"}) {
       const std::string out = dir.path(name);
       r = run_command(kCli + " smooth " + ply + " -o " + out + " " + mode, dir.dir());
-      EXPECT_EQ(r.exit_code, 1) << name << " " << mode << ": " << r.err;
-      EXPECT_EQ(r.err.rfind("sdfkit: error: " + out + ": ", 0), 0u) << r.err;
+      EXPECT_EQ(r.exit_code, 2) << name << " " << mode << ": " << r.err;  // a usage error
+      EXPECT_EQ(r.err.rfind("sdfkit: usage error: " + out + ": ", 0), 0u) << r.err;
       EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
       EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
       EXPECT_FALSE(std::filesystem::exists(out)) << out;

@@ -128,9 +128,9 @@ struct WriteOptions {
   std::vector<std::array<glm::vec2, 3>> texcoord1;
 };
 
-// Throws InputError when a `domain` field cannot be written to `out_path` at all: unknown
-// extension, OBJ/OFF (nowhere to put values), per-face values to glTF. Cheap: call it before
-// computing; write_field checks the same.
+// Throws UsageError (an InputError; the CLI exits 2) when a `domain` field cannot be written to
+// `out_path` at all: unknown extension, OBJ/OFF (nowhere to put values), per-face values to glTF.
+// Cheap: call it before computing; write_field checks the same.
 void check_output(const std::string& out_path, SdfDomain domain);
 
 // Writes `field` (computed on asset.mesh) to out_path; the format follows the extension:
