@@ -70,6 +70,7 @@ void add_info_command(CLI::App& app) {
           {"non_manifold_edges", r.non_manifold_edges},
           {"degenerate_faces", r.degenerate_faces},
           {"isolated_vertices", r.isolated_vertices},
+          {"flipped_faces", asset.flipped_faces},
           {"closed", r.boundary_edges == 0 && r.non_manifold_edges == 0},
           {"warnings", asset.warnings}});
       std::printf("%s\n", j.dump(2).c_str());
@@ -84,6 +85,8 @@ void add_info_command(CLI::App& app) {
     std::printf("non-manifold edges: %zu\n", r.non_manifold_edges);
     std::printf("degenerate faces:   %zu\n", r.degenerate_faces);
     std::printf("isolated vertices:  %zu\n", r.isolated_vertices);
+    std::printf("flipped faces:      %zu%s\n", asset.flipped_faces,
+                asset.flipped_faces ? " (wound against the others or inside out; computed flipped)" : "");
     for (const std::string& w : asset.warnings) std::printf("warning:            %s\n", w.c_str());
   });
 }

@@ -5,6 +5,7 @@
 #include "readers.hpp"
 
 #include "sdfkit/core/log.hpp"
+#include "sdfkit/core/orient.hpp"
 #include "sdfkit/core/weld.hpp"
 
 #include <algorithm>
@@ -295,6 +296,15 @@ Asset load_from_memory(const std::string& path, Format format, std::string_view 
   asset.mesh = std::move(welded.mesh);
   asset.input_to_welded = std::move(welded.input_to_welded);
   asset.load_stages.push_back({"weld", ms_since(weld_start)});
+  // On the welded mesh: the input's UV and normal seams would cut its pieces apart.
+  const auto orient_start = std::chrono::steady_clock::now();
+  const OrientReport orientation = orient_outward(asset.mesh);
+  asset.flipped_faces = orientation.flipped_faces;
+  if (const std::string w = orientation.summary(); !w.empty()) {
+    asset.warnings.push_back(w);
+    log_warning(path + ": " + w);
+  }
+  asset.load_stages.push_back({"orient", ms_since(orient_start)});
   return asset;
 }
 

@@ -2,6 +2,7 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
+#include "sdfkit/core/orient.hpp"
 #include "sdfkit/core/weld.hpp"
 #include "sdfkit/io/solids.hpp"
 #include "sdfkit/post/smooth.hpp"
@@ -64,6 +65,7 @@ SdfField compute_solids(Session& session, const io::Asset& asset, const io::Soli
       }
     }
     WeldResult welded = weld(positions, triangles, asset.weld_tolerance);
+    orient_outward(welded.mesh);  // as load_asset did to the whole mesh (its warning said so)
     session.set_mesh(std::move(welded.mesh));
     const SdfField f = session.compute(options);
     accumulate_stages(stages, session.backend().last_timings());
@@ -124,7 +126,7 @@ io::Asset load_input(const std::string& path, const io::LoadOptions& options) {
   asset.input_triangles = mesh.triangles;
   asset.weld_tolerance = io::weld_tolerance_for(options, mesh.positions);
   WeldResult welded = weld(mesh.positions, mesh.triangles, asset.weld_tolerance);
-  asset.mesh = std::move(welded.mesh);
+  asset.mesh = std::move(welded.mesh);  // built outward: nothing for orient_outward to do
   asset.input_to_welded = std::move(welded.input_to_welded);
   return asset;
 }
@@ -260,7 +262,8 @@ ComputeResult compute_impl(const ComputeRequest& request, io::Asset* preloaded, 
   if (field.filled_count > 0)
     report.warnings.push_back(std::to_string(field.filled_count) + " of " +
                               std::to_string(field.values.size()) +
-                              " points had no accepted ray and were filled from their neighbours");
+                              " points had no accepted ray and were filled from their neighbours (with the mean SDF "
+                              "where none had a value: a vertex no triangle uses)");
 
   if (request.smooth_rings > 0) {
     SmoothOptions smooth;

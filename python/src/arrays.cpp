@@ -1,6 +1,8 @@
 #include "arrays.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/log.hpp"
+#include "sdfkit/core/orient.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -96,6 +98,8 @@ Mesh to_mesh(const py::handle& vertices, const py::handle& faces, const char* wh
   mesh.positions = to_positions(vertices, "vertices");
   mesh.triangles = to_triangles(faces, "faces");
   validate_mesh(mesh, what);
+  // As a loaded file's mesh is (load_asset): the SDF needs every piece wound outward.
+  if (const std::string w = orient_outward(mesh).summary(); !w.empty()) log_warning(std::string(what) + ": " + w);
   return mesh;
 }
 

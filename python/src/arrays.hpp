@@ -28,7 +28,8 @@ std::vector<Triangle> to_triangles(const py::handle& array, const char* what);
 std::vector<float> to_values(const py::handle& array, const char* what);
 
 // A mesh from (V, 3) vertices and (F, 3) faces, checked by validate_mesh (indices in range,
-// finite coordinates, at least one triangle).
+// finite coordinates, at least one triangle), each piece wound outward (orient_outward, with a
+// logged warning when faces were flipped).
 Mesh to_mesh(const py::handle& vertices, const py::handle& faces, const char* what);
 
 // Moves a vector into a 1-D numpy array that owns it (no copy).

@@ -223,7 +223,8 @@ calls on it run one at a time, with the GIL released while they compute.)doc")
 
 vertices: (V, 3) positions, any real or integer dtype (converted to float32), model units.
 faces:    (F, 3) vertex indices (integers, or floats holding whole numbers), counter-clockwise
-          seen from outside. Raises sdfkit.InputError for another shape, NaN/Inf coordinates,
+          seen from outside; faces wound otherwise are flipped for the computation (each piece
+          coherent and outward, with a logged warning). Raises sdfkit.InputError for another shape, NaN/Inf coordinates,
           negative or out-of-range indices, or no faces.)doc")
       .def(
           "set_mesh",
@@ -255,8 +256,8 @@ faces:    (F, 3) vertex indices (integers, or floats holding whole numbers), cou
           py::kw_only(), "per"_a = "vertex", "rays"_a = kDefaultRays, "cone"_a = kDefaultConeDegrees,
           "false_hits"_a = "paper",
           R"doc(The SDF of the current mesh: a (V,) (per="vertex") or (F,) (per="face") float32 array in
-model units, finite everywhere (points without an accepted ray are filled from their neighbours;
-see last_kept_rays).
+model units, finite everywhere (points without an accepted ray are filled from their neighbours,
+or with the mean where none has a value; see last_kept_rays).
 
 rays        rays per point (>= 1; ray casting: OpenCL. On a Vulkan session a value other than the
             default is refused with InputError: its samples are its cameras, set by views)

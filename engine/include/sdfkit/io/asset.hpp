@@ -82,13 +82,16 @@ struct Asset {
   // Triangles as indices into input_positions, in input order (polygons fan-triangulated,
   // strips and fans unrolled).
   std::vector<Triangle> input_triangles;
-  // The welded mesh the backends see: same triangle count and order as input_triangles.
+  // The welded mesh the backends see: same triangle count and order as input_triangles, each
+  // piece wound coherently and outward (orient_outward; input_triangles keep the file's winding).
   Mesh mesh;
+  // Faces of `mesh` wound against their input triangle by orient_outward.
+  std::size_t flipped_faces = 0;
   // For each input vertex, its welded vertex in `mesh`.
   std::vector<std::uint32_t> input_to_welded;
   // The welding tolerance used (model units; 0 = bitwise-equal positions).
   float weld_tolerance = 0.0f;
-  // How long loading took: "read" (parse and validate the file), "weld".
+  // How long loading took: "read" (parse and validate the file), "weld", "orient".
   std::vector<StageTiming> load_stages;
   // Things skipped or changed while loading ("skipped 2 LINES primitives"), also logged.
   std::vector<std::string> warnings;
