@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <limits>
 #include <numeric>
 
@@ -15,29 +14,76 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
 bool degenerate(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[2] == t[0]; }
 
-// Half-edge h = 3 f + k runs from corner k of face f to corner k + 1.
-struct HalfEdges {
-  std::vector<std::uint32_t> start;  // per vertex, into `out`
-  std::vector<std::uint32_t> out;    // half-edges leaving each vertex
+// Faces around each vertex (vertex -> faces CSR), degenerate faces left out.
+struct VertexFaces {
+  std::vector<std::uint32_t> start;  // per vertex, into `faces`
+  std::vector<std::uint32_t> faces;
 };
 
-HalfEdges half_edges_by_source(const Mesh& mesh) {
-  HalfEdges he;
+VertexFaces faces_by_vertex(const Mesh& mesh) {
+  VertexFaces vf;
   const std::size_t V = mesh.positions.size();
-  he.start.assign(V + 1, 0);
+  vf.start.assign(V + 1, 0);
   for (const Triangle& t : mesh.triangles)
     if (!degenerate(t))
-      for (std::uint32_t v : t) ++he.start[v + 1];
-  std::partial_sum(he.start.begin(), he.start.end(), he.start.begin());
-  he.out.resize(he.start[V]);
-  std::vector<std::uint32_t> fill(he.start.begin(), he.start.end() - 1);
+      for (std::uint32_t v : t) ++vf.start[v + 1];
+  std::partial_sum(vf.start.begin(), vf.start.end(), vf.start.begin());
+  vf.faces.resize(vf.start[V]);
+  std::vector<std::uint32_t> fill(vf.start.begin(), vf.start.end() - 1);
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     const Triangle& t = mesh.triangles[f];
     if (degenerate(t)) continue;
-    for (std::uint32_t k = 0; k < 3; ++k) he.out[fill[t[k]]++] = static_cast<std::uint32_t>(3 * f + k);
+    for (std::uint32_t v : t) vf.faces[fill[v]++] = static_cast<std::uint32_t>(f);
   }
-  return he;
+  return vf;
 }
+
+// Union-find over faces that also keeps each face's winding relative to its root (parity 1 =
+// wound against it): joining two faces across an edge they use in the same direction asks for
+// opposite windings, in opposite directions for equal ones. A join that contradicts the windings
+// already implied marks the set one-sided.
+class ParityUnionFind {
+public:
+  explicit ParityUnionFind(std::size_t n) : parent_(n), parity_(n, 0), one_sided_(n, 0) {
+    std::iota(parent_.begin(), parent_.end(), 0u);
+  }
+  // The root of x and x's parity relative to it (path compressed).
+  std::uint32_t find(std::uint32_t x, std::uint8_t& parity) {
+    std::uint32_t r = x;
+    std::uint8_t p = 0;
+    while (parent_[r] != r) p ^= parity_[r], r = parent_[r];
+    // Second pass: point every node of the path at the root with its parity to it.
+    std::uint8_t q = p;
+    while (parent_[x] != x) {
+      const std::uint32_t next = parent_[x];
+      const std::uint8_t step = parity_[x];
+      parent_[x] = r;
+      parity_[x] = q;
+      q ^= step;
+      x = next;
+    }
+    parity = p;
+    return r;
+  }
+  void unite(std::uint32_t a, std::uint32_t b, std::uint8_t differ) {
+    std::uint8_t pa = 0, pb = 0;
+    const std::uint32_t ra = find(a, pa), rb = find(b, pb);
+    if (ra == rb) {
+      if ((pa ^ pb) != differ) one_sided_[ra] = 1;
+      return;
+    }
+    // The larger index under the smaller: roots are each set's first face.
+    const auto [hi, lo] = ra < rb ? std::pair{rb, ra} : std::pair{ra, rb};
+    parent_[hi] = lo;
+    parity_[hi] = static_cast<std::uint8_t>(pa ^ pb ^ differ);
+    one_sided_[lo] |= one_sided_[hi];
+  }
+  bool one_sided(std::uint32_t root) const { return one_sided_[root] != 0; }
+
+private:
+  std::vector<std::uint32_t> parent_;
+  std::vector<std::uint8_t> parity_, one_sided_;
+};
 
 // The solid angle of triangle (a, b, c) seen from q (Van Oosterom and Strackee), signed by its
 // winding.
@@ -71,53 +117,62 @@ OrientReport orient_outward(Mesh& mesh) {
   OrientReport report;
   const std::size_t F = mesh.triangles.size();
   if (F == 0) return report;
-  const HalfEdges he = half_edges_by_source(mesh);
-  const auto to = [&](std::uint32_t h) { return mesh.triangles[h / 3][(h % 3 + 1) % 3]; };
-  const auto from = [&](std::uint32_t h) { return mesh.triangles[h / 3][h % 3]; };
-  // The one other use of h's edge when exactly two faces use it: (half-edge, same direction).
-  const auto partner = [&](std::uint32_t h, std::uint32_t& other, bool& same) {
-    const std::uint32_t a = from(h), b = to(h);
-    std::size_t uses = 1;
-    for (std::uint32_t i = he.start[b]; i < he.start[b + 1]; ++i)
-      if (to(he.out[i]) == a) ++uses, other = he.out[i], same = false;
-    for (std::uint32_t i = he.start[a]; i < he.start[a + 1]; ++i)
-      if (he.out[i] != h && to(he.out[i]) == b) ++uses, other = he.out[i], same = true;
-    return uses == 2;
-  };
-
-  // Pieces, breadth first; parity 1 = wound against the piece's first face.
-  std::vector<std::uint32_t> piece(F, kNone);
+  // Each edge {a, b} is seen from its smaller end a: the faces around a that use it, as a -> b
+  // (b follows a in the face) or as b -> a (b precedes a). One read of each corner's face.
+  ParityUnionFind uf(F);
+  std::vector<std::uint8_t> open_face(F, 0);  // touches a boundary or non-manifold edge
+  {
+    const VertexFaces vf = faces_by_vertex(mesh);
+    struct Corner {
+      std::uint32_t face, next, prev;
+    };
+    std::vector<Corner> around;
+    for (std::uint32_t a = 0; a < vf.start.size() - 1; ++a) {
+      around.clear();
+      for (std::uint32_t i = vf.start[a]; i < vf.start[a + 1]; ++i) {
+        const Triangle& t = mesh.triangles[vf.faces[i]];
+        const int k = t[0] == a ? 0 : (t[1] == a ? 1 : 2);
+        around.push_back({vf.faces[i], t[(k + 1) % 3], t[(k + 2) % 3]});
+      }
+      for (std::size_t i = 0; i < around.size(); ++i)
+        for (const std::uint32_t b : {around[i].next, around[i].prev}) {
+          if (b <= a) continue;
+          // Handle edge {a, b} once: at its first use around a.
+          bool earlier = false;
+          for (std::size_t j = 0; j < i && !earlier; ++j) earlier = around[j].next == b || around[j].prev == b;
+          if (earlier || (b == around[i].prev && around[i].next == b)) continue;
+          std::uint32_t uses = 0, f[2] = {0, 0};
+          std::uint8_t forward[2] = {0, 0};
+          for (std::size_t j = i; j < around.size(); ++j)
+            for (const bool fw : {true, false})
+              if ((fw ? around[j].next : around[j].prev) == b) {
+                if (uses < 2) f[uses] = around[j].face, forward[uses] = fw;
+                ++uses;
+              }
+          if (uses == 2) {
+            uf.unite(f[0], f[1], static_cast<std::uint8_t>(forward[0] == forward[1]));
+          } else {
+            for (std::size_t j = i; j < around.size(); ++j)
+              if (around[j].next == b || around[j].prev == b) open_face[around[j].face] = 1;
+          }
+        }
+    }
+  }
+  // Pieces numbered in the order of their first face; parity relative to that face.
+  std::vector<std::uint32_t> piece(F, kNone), piece_of_root(F, kNone);
   std::vector<std::uint8_t> parity(F, 0);
   std::vector<std::uint8_t> closed, incoherent, orientable;
-  std::deque<std::uint32_t> queue;
-  for (std::uint32_t seed = 0; seed < F; ++seed) {
-    if (piece[seed] != kNone || degenerate(mesh.triangles[seed])) continue;
-    const auto id = static_cast<std::uint32_t>(closed.size());
-    closed.push_back(1), incoherent.push_back(0), orientable.push_back(1);
-    piece[seed] = id;
-    queue.push_back(seed);
-    while (!queue.empty()) {
-      const std::uint32_t f = queue.front();
-      queue.pop_front();
-      for (std::uint32_t k = 0; k < 3; ++k) {
-        std::uint32_t other = 0;
-        bool same = false;
-        if (!partner(3 * f + k, other, same)) {
-          closed[id] = 0;
-          continue;
-        }
-        const std::uint32_t g = other / 3;
-        const auto want = static_cast<std::uint8_t>(parity[f] ^ static_cast<std::uint8_t>(same));
-        if (piece[g] == kNone) {
-          piece[g] = id;
-          parity[g] = want;
-          incoherent[id] |= want;
-          queue.push_back(g);
-        } else if (parity[g] != want) {
-          orientable[id] = 0;
-        }
-      }
+  for (std::uint32_t f = 0; f < F; ++f) {
+    if (degenerate(mesh.triangles[f])) continue;
+    const std::uint32_t root = uf.find(f, parity[f]);
+    if (piece_of_root[root] == kNone) {
+      piece_of_root[root] = static_cast<std::uint32_t>(closed.size());
+      closed.push_back(1), incoherent.push_back(0), orientable.push_back(uf.one_sided(root) ? 0 : 1);
     }
+    const std::uint32_t p = piece_of_root[root];
+    piece[f] = p;
+    incoherent[p] |= parity[f];
+    if (open_face[f]) closed[p] = 0;
   }
   const std::size_t P = closed.size();
   report.pieces = P;
