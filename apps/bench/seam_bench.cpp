@@ -24,7 +24,8 @@
 // against each reference).
 //
 // With the band, each vertex is read back from every chart covering it, blended (StmOptions::blend),
-// unless --no-blend. The blur's width follows the charts' local stretch (DiffuseOptions::stretch)
+// unless --no-blend. Joint and sheet charts are conformal maps (StmOptions::conformal) unless
+// --no-conformal (their projections). The blur's width follows the charts' local stretch (DiffuseOptions::stretch)
 // unless --no-stretch (one width per chart). The tex/k column "per chart" gives the same ratio
 // with one width per chart, from the same mapping in the same run (the stretch compensation's
 // own effect), and the summary counts it too.
@@ -37,7 +38,7 @@
 // vertices' own charts, their share of the vertices, the RMS of texture space and of k-ring
 // against heat over them, and the kind's share of texture space's squared error.
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 8,1] [--steps N] [--no-band] [--no-blend] [--no-stretch] [--no-per-chart]
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 8,1] [--steps N] [--no-band] [--no-blend] [--no-conformal] [--no-stretch] [--no-per-chart]
 //                     [--by-kind] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
   CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
   std::vector<std::string> meshes;
   std::vector<float> sigmas;
-  bool no_band = false, no_blend = false, no_stretch = false, by_kind = false, no_per_chart = false;
+  bool no_band = false, no_blend = false, no_conformal = false, no_stretch = false, by_kind = false, no_per_chart = false;
   std::uint32_t atlas_size = 2048;
   bool models = false;
   std::uint32_t blur_steps = 0;
@@ -86,6 +87,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
   app.add_flag("--no-blend", no_blend, "Every vertex read back from its own chart only (no blend over the charts covering it)");
+  app.add_flag("--no-conformal", no_conformal, "Joint and sheet charts keep their projections (no least squares conformal maps)");
   app.add_flag("--no-stretch", no_stretch, "One blur width in texels per chart (its mean scale) instead of one per texel from the map's local stretch");
   app.add_flag("--no-per-chart", no_per_chart, "Skip the comparison run with one blur width per chart (the 'tex/k per chart' columns: n/a); halves the time");
   app.add_flag("--by-kind", by_kind, "After each row, the error against heat per chart kind (bone, joint, sheet)");
@@ -126,9 +128,10 @@ int main(int argc, char** argv) {
   try {
     vk::Context ctx{vk::ContextConfig{}};
     diffusion::Diffuser diffuser(ctx);
-    std::printf("atlas %u², band %s, %s, %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
+    std::printf("atlas %u², band %s, %s, %s, %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
                 "Against heat diffusion: texture Pearson / median rel. / RMS; k-ring RMS; tex/k = RMS ratio.\n\n",
                 atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back",
+                no_conformal ? "projected joint charts" : "conformal joint charts",
                 no_stretch ? "one blur width per chart" : "stretch-compensated blur",
                 blur_steps == 0 ? "automatic steps" : (blur_steps == 1 ? "one blur (1 step)" : (std::to_string(blur_steps) + " steps").c_str()));
     std::printf("Heat reference: %d implicit step%s of t / %d", heat_steps[0], heat_steps[0] == 1 ? "" : "s", heat_steps[0]);
@@ -168,6 +171,7 @@ int main(int argc, char** argv) {
           so.atlas_size = atlas_size;
           so.overlap = no_band ? 0.0 : diffusion::kBandSigmas * sigma;
           so.blend = !no_blend;
+          so.conformal = !no_conformal;
           const diffusion::Stm stm = diffusion::build_stm(m, skel, so);
           diffusion::DiffuseOptions o;
           o.sigma = sigma;

@@ -2,13 +2,15 @@
 // The road (build_stm): vertex → node ──▶ bones (chains between joints) with rotation-minimizing
 // frames ──▶ each vertex to a bone, an end cap or a planar region ──▶ demote the vertices of
 // stretched or flipped triangles to planar regions (repeat) ──▶ planar regions split into charts
-// by normal direction ──▶ atlas triangles (one per face and chart it touches) ──▶ chart extents
-// ──▶ scale and shelf packing ──▶ texel coordinates ──▶ quality.
+// by normal direction ──▶ atlas triangles (one per face and chart it touches) ──▶ overlap bands,
+// and conformal maps (LSCM) for the joint and sheet charts over their faces and bands ──▶ chart
+// extents ──▶ scale and shelf packing ──▶ texel coordinates ──▶ quality.
 #include "sdfkit/diffusion/stm.hpp"
 
 #include "sdfkit/core/error.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -673,10 +675,24 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     }
   };
 
+  // Per chart, where filled: each vertex's coordinates in the chart's conformal map (5c), which
+  // replaces the chart's projection; a vertex outside the map's domain has none (NaN).
+  std::vector<std::unordered_map<std::uint32_t, glm::dvec2>> conformal;
+  const auto vertex_local = [&](std::uint32_t c, std::uint32_t v) {
+    if (c < conformal.size() && !conformal[c].empty()) {
+      const auto it = conformal[c].find(v);
+      return it != conformal[c].end() ? it->second : glm::dvec2(std::numeric_limits<double>::quiet_NaN());
+    }
+    return local_coords(maps[c], B, glm::dvec3(mesh.positions[v]));
+  };
   // Local corners of face f in chart c (model units), wrapping charts unwrapped toward the
   // first corner that belongs to c (or corner 0).
   const auto face_local = [&](std::size_t f, std::uint32_t c, glm::dvec2 (&uv)[3]) {
     const Triangle& t = mesh.triangles[f];
+    if (c < conformal.size() && !conformal[c].empty()) {
+      for (int k = 0; k < 3; ++k) uv[k] = vertex_local(c, t[k]);
+      return;
+    }
     int ref = 0;
     for (int k = 0; k < 3; ++k) {
       uv[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
@@ -890,7 +906,10 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     const double distortion_k = kBlendDistortion;
     const std::size_t own_triangles = local.size();
     std::vector<std::vector<std::uint32_t>> held(maps.size());  // faces each chart holds already
-    for (std::size_t i = 0; i < own_triangles; ++i) held[local[i].chart].push_back(local[i].face);
+    std::vector<std::vector<std::uint32_t>> held_local(maps.size());  // their indices in `local`
+    for (std::size_t i = 0; i < own_triangles; ++i)
+      held[local[i].chart].push_back(local[i].face), held_local[local[i].chart].push_back(static_cast<std::uint32_t>(i));
+    if (options.conformal) conformal.assign(maps.size(), {});
     // A band must not fold over its own chart either: a band face whose chart triangle overlaps
     // one the chart already holds (a planar map reaching round a limb onto its own far side, an
     // azimuthal map past the antipode, a bone's cylindrical map round a bend) stops the band
@@ -953,6 +972,126 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       });
       return hit;
     };
+    // The least squares conformal map of chart c over `domain` (faces), into conformal[c]: each
+    // face's residual Σ_j W_j ζ_j / √(2 area) (W_j = z_{j+2} - z_{j+1} in the face's own plane,
+    // ζ = u + i v), zero exactly for a similarity; the chart's two vertices farthest apart in its
+    // projection pinned at their distance. False (and nothing kept) where a face of the domain
+    // turns against `orientation` or is squashed past max_stretch, or the solve fails.
+    std::vector<std::int32_t> lscm_index(V, -1);
+    const auto conformal_map = [&](std::uint32_t c, const std::vector<std::uint32_t>& domain, double orientation) {
+      std::vector<std::uint32_t> verts;
+      for (std::uint32_t f : domain)
+        for (std::uint32_t v : mesh.triangles[f])
+          if (lscm_index[v] < 0) lscm_index[v] = static_cast<std::int32_t>(verts.size()), verts.push_back(v);
+      const auto cleanup = [&] {
+        for (std::uint32_t v : verts) lscm_index[v] = -1;
+      };
+      std::uint32_t pa = kNone, pb = kNone;
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (std::uint32_t v : chart_vertices[c]) {
+        const double x = local_coords(maps[c], B, glm::dvec3(mesh.positions[v])).x;
+        if (x < lo) lo = x, pa = v;
+        if (x > hi) hi = x, pb = v;
+      }
+      const double span = pa == kNone || pb == kNone ? 0.0 : glm::length(glm::dvec3(mesh.positions[pb]) - glm::dvec3(mesh.positions[pa]));
+      const auto n = static_cast<std::int32_t>(verts.size());
+      // Both pins must be corners of the domain (a vertex no face uses is not).
+      if (!(span > 0) || n < 3 || lscm_index[pa] < 0 || lscm_index[pb] < 0) return cleanup(), false;
+      const std::int32_t ia = lscm_index[pa], ib = lscm_index[pb];
+      const auto column = [&](std::int32_t i) { return i - (i > ia ? 1 : 0) - (i > ib ? 1 : 0); };
+      std::vector<Eigen::Triplet<double>> entries;
+      std::vector<double> rhs_rows;
+      std::int32_t row = 0;
+      for (std::uint32_t f : domain) {
+        const Triangle& t = mesh.triangles[f];
+        const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
+            e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
+        const glm::dvec3 nrm = glm::cross(e1, e2);
+        const double l1 = glm::length(e1), an = glm::length(nrm);
+        if (!(l1 > 0) || !(an > 1e-14 * l1 * l1)) continue;
+        const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
+        const glm::dvec2 q[3] = {{0, 0}, {l1, 0}, {glm::dot(e2, ux), glm::dot(e2, uy)}};
+        const double w = 1.0 / std::sqrt(an);  // an = twice the area
+        double re = 0, im = 0;
+        for (int j = 0; j < 3; ++j) {
+          const glm::dvec2 wj = q[(j + 2) % 3] - q[(j + 1) % 3];
+          const std::int32_t i = lscm_index[t[j]];
+          if (i == ia || i == ib) {  // pinned: (0, 0) and (span, 0)
+            const double px = i == ia ? 0.0 : span;
+            re += wj.x * px, im += wj.y * px;
+            continue;
+          }
+          const std::int32_t col = column(i);
+          entries.emplace_back(row, 2 * col, w * wj.x);
+          entries.emplace_back(row, 2 * col + 1, -w * wj.y);
+          entries.emplace_back(row + 1, 2 * col, w * wj.y);
+          entries.emplace_back(row + 1, 2 * col + 1, w * wj.x);
+        }
+        rhs_rows.push_back(-w * re);
+        rhs_rows.push_back(-w * im);
+        row += 2;
+      }
+      if (row == 0) return cleanup(), false;
+      Eigen::SparseMatrix<double> A(row, 2 * (n - 2));
+      A.setFromTriplets(entries.begin(), entries.end());
+      const Eigen::Map<const Eigen::VectorXd> rhs(rhs_rows.data(), row);
+      const Eigen::SparseMatrix<double> normal = A.transpose() * A;
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+      if (solver.info() != Eigen::Success) return cleanup(), false;
+      const Eigen::VectorXd x = solver.solve(A.transpose() * rhs);
+      if (solver.info() != Eigen::Success || !x.allFinite()) return cleanup(), false;
+      const auto coord = [&](std::uint32_t v) {
+        const std::int32_t i = lscm_index[v];
+        return i == ia ? glm::dvec2(0.0) : i == ib ? glm::dvec2(span, 0.0) : glm::dvec2(x[2 * column(i)], x[2 * column(i) + 1]);
+      };
+      // Every face keeps one orientation (the projection's, up to a mirror) and its shape.
+      double flip = 0;
+      for (std::uint32_t f : domain) {
+        const Triangle& t = mesh.triangles[f];
+        const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
+        glm::dvec2 pr[3];
+        for (int k = 0; k < 3; ++k) pr[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
+        const double a_new = signed_area2(uv[0], uv[1], uv[2]), a_old = orientation * signed_area2(pr[0], pr[1], pr[2]);
+        if (a_old <= 0) continue;  // faces touching the chart that its projection flips: no say
+        if (flip == 0) flip = a_new > 0 ? 1 : -1;
+        if (!(flip * a_new > 0)) return cleanup(), false;
+        const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
+            e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
+        const glm::dvec3 nrm = glm::cross(e1, e2);
+        const double l1 = glm::length(e1), an = glm::length(nrm);
+        if (!(l1 > 0) || !(an > 0)) continue;
+        const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
+        const double ex = glm::dot(e2, ux), ey = glm::dot(e2, uy);
+        const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+        const double j11 = d1.x / l1, j21 = d1.y / l1, j12 = (d2.x - ex * j11) / ey, j22 = (d2.y - ex * j21) / ey;
+        const auto [s1, s2] = singular_values(j11, j12, j21, j22);
+        if (!(s2 * options.max_stretch >= s1)) return cleanup(), false;
+        // Nor stretched past max_stretch in model units (the projections' test): the atlas's
+        // scale is set by the largest chart, so one map blown up would cost every chart texels.
+        if (!(s1 <= options.max_stretch)) return cleanup(), false;
+      }
+      // Nor folded over itself (the band's overlap test, on the new coordinates).
+      grid.clear();
+      grid_entries.clear();
+      grid_tris.clear();
+      grid_faces.clear();
+      for (std::uint32_t f : domain) {
+        const Triangle& t = mesh.triangles[f];
+        const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
+        if (grid_overlaps(f, uv)) return cleanup(), false;
+        grid_insert(f, uv);
+      }
+      // Mirrored to the projection's orientation, so the band's orientation test still holds.
+      auto& table = conformal[c];
+      table.reserve(verts.size());
+      for (std::uint32_t v : verts) {
+        glm::dvec2 q = coord(v);
+        if (flip * orientation < 0) q.y = -q.y;
+        table[v] = q;
+      }
+      cleanup();
+      return true;
+    };
     for (std::uint32_t c = 0; c < maps.size(); ++c) {
       // A wrapping (bone) chart's x is periodic: each triangle goes in the grid at its place and
       // one period to either side, so a band face that lands on the chart's own surface modulo
@@ -1007,6 +1146,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       }
       const double sign = orientation >= 0 ? 1.0 : -1.0;
       // Grow from the faces the chart holds through vertex-adjacent faces in reach.
+      const std::size_t band_begin = local.size();
       faces = held[c];
       for (std::uint32_t f : faces) face_state[f] = 1;
       for (std::size_t i = 0; i < faces.size(); ++i)
@@ -1034,6 +1174,30 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             ChartMap& m = maps[c];
             for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
           }
+      // 5c. A joint or sheet chart's projection (orthographic, or central onto the sphere of
+      // directions) foreshortens every face it sees obliquely, along the direction the face is
+      // tilted in, which is not an atlas axis: the blur's per-axis widths cannot follow that, and
+      // the map's Laplace-Beltrami operator gains a drift term that no blur carries. A conformal
+      // map's is λ⁻² Δ, what the stretch-compensated blur does. So the faces the chart now holds
+      // (its own and its band's: the projection embeds them in the plane without folds) take a
+      // least squares conformal map (Lévy et al. 2002), kept where every one of them keeps its
+      // orientation and its shape (σ1 / σ2 ≤ max_stretch).
+      if (options.conformal && maps[c].kind != Chart::Kind::Bone) {
+        std::vector<std::uint32_t> domain_faces;
+        for (std::uint32_t f : faces)
+          if (face_state[f] == 1) domain_faces.push_back(f);
+        if (conformal_map(c, domain_faces, sign)) {
+          ChartMap& m = maps[c];
+          m.lo = glm::dvec2(std::numeric_limits<double>::infinity());
+          m.hi = -m.lo;
+          const auto refresh = [&](LocalTri& lt) {
+            face_local(lt.face, c, lt.uv);
+            for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
+          };
+          for (std::uint32_t i : held_local[c]) refresh(local[i]);
+          for (std::size_t i = band_begin; i < local.size(); ++i) refresh(local[i]);
+        }
+      }
       {
         // The vertices the chart covers (corners of its faces), and their distance along the
         // surface to where its coverage ends (covered vertices with a face around them it lacks).
@@ -1116,7 +1280,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
   }
   std::vector<glm::dvec2> vlocal(V);
   for (std::size_t v = 0; v < V; ++v) {
-    vlocal[v] = local_coords(maps[vchart[v]], B, glm::dvec3(mesh.positions[v]));
+    vlocal[v] = vertex_local(vchart[v], static_cast<std::uint32_t>(v));
     ChartMap& m = maps[vchart[v]];
     m.lo = glm::min(m.lo, vlocal[v]);
     m.hi = glm::max(m.hi, vlocal[v]);
@@ -1209,7 +1373,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       am.samples.push_back({static_cast<std::uint32_t>(v), vchart[v], am.vertex_uv[v],
                             static_cast<float>(std::max(own_weight[v], 1e-4))});
     for (const BandSample& b : band_samples) {
-      glm::vec2 q = to_texel(b.chart, local_coords(maps[b.chart], B, glm::dvec3(mesh.positions[b.vertex])));
+      glm::vec2 q = to_texel(b.chart, vertex_local(b.chart, b.vertex));
       const Chart& ch = am.charts[b.chart];
       q.x = std::clamp(q.x, static_cast<float>(ch.x0), std::nextafter(static_cast<float>(ch.x0 + ch.width), 0.0f));
       q.y = std::clamp(q.y, static_cast<float>(ch.y0), std::nextafter(static_cast<float>(ch.y0 + ch.height), 0.0f));

@@ -75,6 +75,12 @@ struct StmOptions {
   // the one that keeps lengths better around the vertex (whose blur of fixed texels is closer to
   // σ in model units there) counts more.
   bool blend = true;
+  // With an overlap band: each joint and sheet chart takes a least squares conformal map (LSCM)
+  // over the faces it holds (its own and its band's) in place of its projection, where every one
+  // of them keeps its orientation and shape (σ1/σ2 ≤ max_stretch), none stretches past
+  // max_stretch and the map does not fold over itself. False: the projections alone
+  // (orthographic, or stereographic around the skeleton).
+  bool conformal = true;
 };
 
 // The blend's reach as a share of the overlap band (StmOptions::blend): the whole band, so a
