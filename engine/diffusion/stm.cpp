@@ -975,17 +975,13 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     // The least squares conformal map of chart c over `domain` (faces), into conformal[c]: each
     // face's residual Σ_j W_j ζ_j / √(2 area) (W_j = z_{j+2} - z_{j+1} in the face's own plane,
     // ζ = u + i v), zero exactly for a similarity; the chart's two vertices farthest apart in its
-    // projection pinned at their distance. False (and nothing kept) where a face of the domain
-    // turns against `orientation` or is squashed past max_stretch, or the solve fails.
+    // projection pinned at their distance. A band face that turns against the chart's own faces,
+    // is squashed (σ1/σ2 > max_stretch) or stretched past max_stretch leaves the domain (into
+    // `trimmed`) and the map is solved again, up to 4 times; false (nothing kept) when one of the
+    // chart's own faces does, the map folds over itself, or the solve fails.
     std::vector<std::int32_t> lscm_index(V, -1);
-    const auto conformal_map = [&](std::uint32_t c, const std::vector<std::uint32_t>& domain, double orientation) {
-      std::vector<std::uint32_t> verts;
-      for (std::uint32_t f : domain)
-        for (std::uint32_t v : mesh.triangles[f])
-          if (lscm_index[v] < 0) lscm_index[v] = static_cast<std::int32_t>(verts.size()), verts.push_back(v);
-      const auto cleanup = [&] {
-        for (std::uint32_t v : verts) lscm_index[v] = -1;
-      };
+    const auto conformal_map = [&](std::uint32_t c, std::vector<std::uint32_t> domain, double orientation,
+                                   std::vector<std::uint32_t>& trimmed) {
       std::uint32_t pa = kNone, pb = kNone;
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
       for (std::uint32_t v : chart_vertices[c]) {
@@ -994,103 +990,141 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         if (x > hi) hi = x, pb = v;
       }
       const double span = pa == kNone || pb == kNone ? 0.0 : glm::length(glm::dvec3(mesh.positions[pb]) - glm::dvec3(mesh.positions[pa]));
-      const auto n = static_cast<std::int32_t>(verts.size());
-      // Both pins must be corners of the domain (a vertex no face uses is not).
-      if (!(span > 0) || n < 3 || lscm_index[pa] < 0 || lscm_index[pb] < 0) return cleanup(), false;
-      const std::int32_t ia = lscm_index[pa], ib = lscm_index[pb];
-      const auto column = [&](std::int32_t i) { return i - (i > ia ? 1 : 0) - (i > ib ? 1 : 0); };
-      std::vector<Eigen::Triplet<double>> entries;
-      std::vector<double> rhs_rows;
-      std::int32_t row = 0;
-      for (std::uint32_t f : domain) {
-        const Triangle& t = mesh.triangles[f];
-        const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
-            e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
-        const glm::dvec3 nrm = glm::cross(e1, e2);
-        const double l1 = glm::length(e1), an = glm::length(nrm);
-        if (!(l1 > 0) || !(an > 1e-14 * l1 * l1)) continue;
-        const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
-        const glm::dvec2 q[3] = {{0, 0}, {l1, 0}, {glm::dot(e2, ux), glm::dot(e2, uy)}};
-        const double w = 1.0 / std::sqrt(an);  // an = twice the area
-        double re = 0, im = 0;
-        for (int j = 0; j < 3; ++j) {
-          const glm::dvec2 wj = q[(j + 2) % 3] - q[(j + 1) % 3];
-          const std::int32_t i = lscm_index[t[j]];
-          if (i == ia || i == ib) {  // pinned: (0, 0) and (span, 0)
-            const double px = i == ia ? 0.0 : span;
-            re += wj.x * px, im += wj.y * px;
-            continue;
-          }
-          const std::int32_t col = column(i);
-          entries.emplace_back(row, 2 * col, w * wj.x);
-          entries.emplace_back(row, 2 * col + 1, -w * wj.y);
-          entries.emplace_back(row + 1, 2 * col, w * wj.y);
-          entries.emplace_back(row + 1, 2 * col + 1, w * wj.x);
-        }
-        rhs_rows.push_back(-w * re);
-        rhs_rows.push_back(-w * im);
-        row += 2;
-      }
-      if (row == 0) return cleanup(), false;
-      Eigen::SparseMatrix<double> A(row, 2 * (n - 2));
-      A.setFromTriplets(entries.begin(), entries.end());
-      const Eigen::Map<const Eigen::VectorXd> rhs(rhs_rows.data(), row);
-      const Eigen::SparseMatrix<double> normal = A.transpose() * A;
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
-      if (solver.info() != Eigen::Success) return cleanup(), false;
-      const Eigen::VectorXd x = solver.solve(A.transpose() * rhs);
-      if (solver.info() != Eigen::Success || !x.allFinite()) return cleanup(), false;
-      const auto coord = [&](std::uint32_t v) {
-        const std::int32_t i = lscm_index[v];
-        return i == ia ? glm::dvec2(0.0) : i == ib ? glm::dvec2(span, 0.0) : glm::dvec2(x[2 * column(i)], x[2 * column(i) + 1]);
+      if (!(span > 0)) return false;
+      std::vector<std::uint32_t> verts, bad;
+      const auto cleanup = [&] {
+        for (std::uint32_t v : verts) lscm_index[v] = -1;
+        verts.clear();
       };
-      // Every face keeps one orientation (the projection's, up to a mirror) and its shape.
-      double flip = 0;
-      for (std::uint32_t f : domain) {
-        const Triangle& t = mesh.triangles[f];
-        const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
-        glm::dvec2 pr[3];
-        for (int k = 0; k < 3; ++k) pr[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
-        const double a_new = signed_area2(uv[0], uv[1], uv[2]), a_old = orientation * signed_area2(pr[0], pr[1], pr[2]);
-        if (a_old <= 0) continue;  // faces touching the chart that its projection flips: no say
-        if (flip == 0) flip = a_new > 0 ? 1 : -1;
-        if (!(flip * a_new > 0)) return cleanup(), false;
-        const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
-            e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
-        const glm::dvec3 nrm = glm::cross(e1, e2);
-        const double l1 = glm::length(e1), an = glm::length(nrm);
-        if (!(l1 > 0) || !(an > 0)) continue;
-        const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
-        const double ex = glm::dot(e2, ux), ey = glm::dot(e2, uy);
-        const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
-        const double j11 = d1.x / l1, j21 = d1.y / l1, j12 = (d2.x - ex * j11) / ey, j22 = (d2.y - ex * j21) / ey;
-        const auto [s1, s2] = singular_values(j11, j12, j21, j22);
-        if (!(s2 * options.max_stretch >= s1)) return cleanup(), false;
-        // Nor stretched past max_stretch in model units (the projections' test): the atlas's
-        // scale is set by the largest chart, so one map blown up would cost every chart texels.
-        if (!(s1 <= options.max_stretch)) return cleanup(), false;
+      for (int round = 0; round < 4; ++round) {
+        cleanup();
+        for (std::uint32_t f : domain)
+          for (std::uint32_t v : mesh.triangles[f])
+            if (lscm_index[v] < 0) lscm_index[v] = static_cast<std::int32_t>(verts.size()), verts.push_back(v);
+        const auto n = static_cast<std::int32_t>(verts.size());
+        // Both pins must be corners of the domain (a vertex no face uses is not).
+        if (n < 3 || lscm_index[pa] < 0 || lscm_index[pb] < 0) return cleanup(), false;
+        const std::int32_t ia = lscm_index[pa], ib = lscm_index[pb];
+        const auto column = [&](std::int32_t i) { return i - (i > ia ? 1 : 0) - (i > ib ? 1 : 0); };
+        std::vector<Eigen::Triplet<double>> entries;
+        std::vector<double> rhs_rows;
+        std::int32_t row = 0;
+        for (std::uint32_t f : domain) {
+          const Triangle& t = mesh.triangles[f];
+          const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
+              e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
+          const glm::dvec3 nrm = glm::cross(e1, e2);
+          const double l1 = glm::length(e1), an = glm::length(nrm);
+          if (!(l1 > 0) || !(an > 1e-14 * l1 * l1)) continue;
+          const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
+          const glm::dvec2 q[3] = {{0, 0}, {l1, 0}, {glm::dot(e2, ux), glm::dot(e2, uy)}};
+          const double w = 1.0 / std::sqrt(an);  // an = twice the area
+          double re = 0, im = 0;
+          for (int j = 0; j < 3; ++j) {
+            const glm::dvec2 wj = q[(j + 2) % 3] - q[(j + 1) % 3];
+            const std::int32_t i = lscm_index[t[j]];
+            if (i == ia || i == ib) {  // pinned: (0, 0) and (span, 0)
+              const double px = i == ia ? 0.0 : span;
+              re += wj.x * px, im += wj.y * px;
+              continue;
+            }
+            const std::int32_t col = column(i);
+            entries.emplace_back(row, 2 * col, w * wj.x);
+            entries.emplace_back(row, 2 * col + 1, -w * wj.y);
+            entries.emplace_back(row + 1, 2 * col, w * wj.y);
+            entries.emplace_back(row + 1, 2 * col + 1, w * wj.x);
+          }
+          rhs_rows.push_back(-w * re);
+          rhs_rows.push_back(-w * im);
+          row += 2;
+        }
+        if (row == 0) return cleanup(), false;
+        Eigen::SparseMatrix<double> A(row, 2 * (n - 2));
+        A.setFromTriplets(entries.begin(), entries.end());
+        const Eigen::Map<const Eigen::VectorXd> rhs(rhs_rows.data(), row);
+        const Eigen::SparseMatrix<double> normal = A.transpose() * A;
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+        if (solver.info() != Eigen::Success) return cleanup(), false;
+        const Eigen::VectorXd x = solver.solve(A.transpose() * rhs);
+        if (solver.info() != Eigen::Success || !x.allFinite()) return cleanup(), false;
+        const auto coord = [&](std::uint32_t v) {
+          const std::int32_t i = lscm_index[v];
+          return i == ia ? glm::dvec2(0.0) : i == ib ? glm::dvec2(span, 0.0) : glm::dvec2(x[2 * column(i)], x[2 * column(i) + 1]);
+        };
+        // The orientation of the chart's own faces (up to a mirror, the projection's), and the
+        // faces that turn against it, are squashed or stretched. A face touching the chart that
+        // its projection already flipped has no say.
+        const auto own_face = [&](const Triangle& t) { return vchart[t[0]] == c || vchart[t[1]] == c || vchart[t[2]] == c; };
+        const auto projected_ok = [&](const Triangle& t) {
+          glm::dvec2 pr[3];
+          for (int k = 0; k < 3; ++k) pr[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
+          return orientation * signed_area2(pr[0], pr[1], pr[2]) > 0;
+        };
+        double votes = 0;
+        for (std::uint32_t f : domain) {
+          const Triangle& t = mesh.triangles[f];
+          if (!own_face(t) || !projected_ok(t)) continue;
+          votes += signed_area2(coord(t[0]), coord(t[1]), coord(t[2])) > 0 ? 1 : -1;
+        }
+        const double flip = votes >= 0 ? 1.0 : -1.0;
+        bad.clear();
+        bool own_bad = false;
+        for (std::uint32_t f : domain) {
+          const Triangle& t = mesh.triangles[f];
+          if (!projected_ok(t)) continue;
+          const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
+          bool fine = flip * signed_area2(uv[0], uv[1], uv[2]) > 0;
+          const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
+              e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
+          const glm::dvec3 nrm = glm::cross(e1, e2);
+          const double l1 = glm::length(e1), an = glm::length(nrm);
+          if (fine && l1 > 0 && an > 0) {
+            const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
+            const double ex = glm::dot(e2, ux), ey = glm::dot(e2, uy);
+            const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+            const double j11 = d1.x / l1, j21 = d1.y / l1, j12 = (d2.x - ex * j11) / ey, j22 = (d2.y - ex * j21) / ey;
+            const auto [s1, s2] = singular_values(j11, j12, j21, j22);
+            // Shape kept, and no stretch past max_stretch in model units (the projections' test:
+            // the atlas's scale is set by the largest chart, one map blown up costs every chart).
+            fine = s2 * options.max_stretch >= s1 && s1 <= options.max_stretch;
+          }
+          if (fine) continue;
+          if (own_face(t)) own_bad = true;
+          bad.push_back(f);
+        }
+        if (own_bad) return cleanup(), false;
+        if (!bad.empty()) {
+          if (round == 3) return cleanup(), false;
+          std::sort(bad.begin(), bad.end());
+          domain.erase(std::remove_if(domain.begin(), domain.end(),
+                                      [&](std::uint32_t f) { return std::binary_search(bad.begin(), bad.end(), f); }),
+                       domain.end());
+          trimmed.insert(trimmed.end(), bad.begin(), bad.end());
+          continue;
+        }
+        // Nor folded over itself (the band's overlap test, on the new coordinates).
+        grid.clear();
+        grid_entries.clear();
+        grid_tris.clear();
+        grid_faces.clear();
+        for (std::uint32_t f : domain) {
+          const Triangle& t = mesh.triangles[f];
+          const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
+          if (grid_overlaps(f, uv)) return cleanup(), false;
+          grid_insert(f, uv);
+        }
+        // Mirrored to the projection's orientation, so the band's orientation test still holds.
+        auto& table = conformal[c];
+        table.reserve(verts.size());
+        for (std::uint32_t v : verts) {
+          glm::dvec2 q = coord(v);
+          if (flip * orientation < 0) q.y = -q.y;
+          table[v] = q;
+        }
+        cleanup();
+        return true;
       }
-      // Nor folded over itself (the band's overlap test, on the new coordinates).
-      grid.clear();
-      grid_entries.clear();
-      grid_tris.clear();
-      grid_faces.clear();
-      for (std::uint32_t f : domain) {
-        const Triangle& t = mesh.triangles[f];
-        const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
-        if (grid_overlaps(f, uv)) return cleanup(), false;
-        grid_insert(f, uv);
-      }
-      // Mirrored to the projection's orientation, so the band's orientation test still holds.
-      auto& table = conformal[c];
-      table.reserve(verts.size());
-      for (std::uint32_t v : verts) {
-        glm::dvec2 q = coord(v);
-        if (flip * orientation < 0) q.y = -q.y;
-        table[v] = q;
-      }
-      cleanup();
-      return true;
+      return cleanup(), false;
     };
     for (std::uint32_t c = 0; c < maps.size(); ++c) {
       // A wrapping (bone) chart's x is periodic: each triangle goes in the grid at its place and
@@ -1186,7 +1220,15 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         std::vector<std::uint32_t> domain_faces;
         for (std::uint32_t f : faces)
           if (face_state[f] == 1) domain_faces.push_back(f);
-        if (conformal_map(c, domain_faces, sign)) {
+        std::vector<std::uint32_t> trimmed;
+        if (conformal_map(c, domain_faces, sign, trimmed)) {
+          // The band faces the map could not keep leave the band.
+          if (!trimmed.empty()) {
+            for (std::uint32_t f : trimmed) face_state[f] = 2;
+            local.erase(std::remove_if(local.begin() + static_cast<std::ptrdiff_t>(band_begin), local.end(),
+                                       [&](const LocalTri& lt) { return face_state[lt.face] == 2; }),
+                        local.end());
+          }
           ChartMap& m = maps[c];
           m.lo = glm::dvec2(std::numeric_limits<double>::infinity());
           m.hi = -m.lo;

@@ -76,10 +76,11 @@ struct StmOptions {
   // σ in model units there) counts more.
   bool blend = true;
   // With an overlap band: each joint and sheet chart takes a least squares conformal map (LSCM)
-  // over the faces it holds (its own and its band's) in place of its projection, where every one
-  // of them keeps its orientation and shape (σ1/σ2 ≤ max_stretch), none stretches past
-  // max_stretch and the map does not fold over itself. False: the projections alone
-  // (orthographic, or stereographic around the skeleton).
+  // over the faces it holds (its own and its band's) in place of its projection. Band faces the
+  // map turns over, squashes (σ1/σ2 > max_stretch) or stretches past max_stretch leave the band
+  // (the map is solved again, up to 4 times); kept where the chart's own faces all pass and the
+  // map does not fold over itself. False: the projections alone (orthographic, or stereographic
+  // around the skeleton).
   bool conformal = true;
 };
 
