@@ -21,6 +21,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 namespace sdfkit::diffusion {
@@ -270,6 +271,22 @@ std::pair<double, double> singular_values(double a, double b, double c, double d
   const double e = (a + d) / 2, f = (a - d) / 2, g = (c + b) / 2, h = (c - b) / 2;
   const double q = std::hypot(e, h), r = std::hypot(f, g);
   return {q + r, std::abs(q - r)};
+}
+
+// σ1 ≥ σ2 of the linear map taking triangle (p0, p1, p2), in its own plane, to the chart points
+// uv (chart units per model unit); nothing for a degenerate triangle.
+std::optional<std::pair<double, double>> face_map_singular_values(const glm::dvec3& p0, const glm::dvec3& p1,
+                                                                  const glm::dvec3& p2, const glm::dvec2 (&uv)[3]) {
+  const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
+  const double l1 = glm::length(e1), an = glm::length(n);
+  if (!(l1 > 0) || !(an > 0)) return std::nullopt;
+  const glm::dvec3 ux = e1 / l1, uy = glm::cross(n / an, ux);
+  // P = [p1 p2] in the triangle's plane, D = [d1 d2] in the chart: J = D P^-1, with
+  // P^-1 = [[1/l1, -ex/(l1 ey)], [0, 1/ey]].
+  const double ex = glm::dot(e2, ux), ey = glm::dot(e2, uy);
+  const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+  const double j11 = d1.x / l1, j21 = d1.y / l1, j12 = (d2.x - ex * j11) / ey, j22 = (d2.y - ex * j21) / ey;
+  return singular_values(j11, j12, j21, j22);
 }
 
 }  // namespace
@@ -1074,20 +1091,11 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
           if (!projected_ok(t)) continue;
           const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
           bool fine = flip * signed_area2(uv[0], uv[1], uv[2]) > 0;
-          const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
-              e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
-          const glm::dvec3 nrm = glm::cross(e1, e2);
-          const double l1 = glm::length(e1), an = glm::length(nrm);
-          if (fine && l1 > 0 && an > 0) {
-            const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
-            const double ex = glm::dot(e2, ux), ey = glm::dot(e2, uy);
-            const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
-            const double j11 = d1.x / l1, j21 = d1.y / l1, j12 = (d2.x - ex * j11) / ey, j22 = (d2.y - ex * j21) / ey;
-            const auto [s1, s2] = singular_values(j11, j12, j21, j22);
-            // Shape kept, and no stretch past max_stretch in model units (the projections' test:
-            // the atlas's scale is set by the largest chart, one map blown up costs every chart).
-            fine = s2 * options.max_stretch >= s1 && s1 <= options.max_stretch;
-          }
+          const auto sv = face_map_singular_values(glm::dvec3(mesh.positions[t[0]]), glm::dvec3(mesh.positions[t[1]]),
+                                                   glm::dvec3(mesh.positions[t[2]]), uv);
+          // Shape kept, and no stretch past max_stretch in model units (the projections' test:
+          // the atlas's scale is set by the largest chart, one map blown up costs every chart).
+          if (fine && sv) fine = sv->second * options.max_stretch >= sv->first && sv->first <= options.max_stretch;
           if (fine) continue;
           if (own_face(t)) own_bad = true;
           bad.push_back(f);
@@ -1280,22 +1288,10 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
             glm::dvec2 uv[3];
             face_local(f, c, uv);
             const Triangle& t = mesh.triangles[f];
-            const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
-                e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
-            const double l1 = glm::length(e1);
-            const glm::dvec3 n = glm::cross(e1, e2);
-            const double an = glm::length(n);
-            if (!(l1 > 0) || !(an > 0)) continue;
-            const glm::dvec3 ux = e1 / l1, uy = glm::cross(n / an, ux);
-            // P = [p1 p2] in the triangle's plane, D = [d1 d2] in the chart; J = D P^-1.
-            const double a = l1, b = glm::dot(e2, ux), cc = glm::dot(e2, uy);
-            const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
-            // P^-1 = [[1/a, -b/(a cc)], [0, 1/cc]]
-            const double j11 = d1.x / a, j21 = d1.y / a;
-            const double j12 = (d2.x - b * j11) / cc, j22 = (d2.y - b * j21) / cc;
-            const double pe = 0.5 * (j11 + j22), pf = 0.5 * (j11 - j22), pg = 0.5 * (j21 + j12), ph = 0.5 * (j21 - j12);
-            const double sq = std::sqrt(pe * pe + ph * ph), sr = std::sqrt(pf * pf + pg * pg);
-            const double s1 = sq + sr, s2 = std::abs(sq - sr);
+            const auto sv = face_map_singular_values(glm::dvec3(mesh.positions[t[0]]), glm::dvec3(mesh.positions[t[1]]),
+                                                     glm::dvec3(mesh.positions[t[2]]), uv);
+            if (!sv) continue;
+            const auto [s1, s2] = *sv;
             if (!(s2 > 1e-9)) continue;
             const double delta = std::log(s1) * std::log(s1) + std::log(s2) * std::log(s2);
             for (std::uint32_t v : t) dsum[v] += delta, dcnt[v] += 1;
