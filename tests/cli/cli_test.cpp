@@ -86,6 +86,22 @@ TEST_F(Cli, InfoReportsAnOpenMesh) {
   EXPECT_NE(r.out.find("\"closed\": false"), std::string::npos) << r.out;
 }
 
+// CGAL's boeing mixes windings (1432 of its 2564 faces wound against the rest): the load winds
+// it outward, says so in one warning line, and info counts the flipped faces; the cow is wound
+// right and nothing is flipped.
+TEST_F(Cli, InfoCountsTheFacesTheLoadFlipped) {
+  const RunResult r = run("info --json " + sdfkit::test::data_mesh("boeing.off"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"flipped_faces\": 1432"), std::string::npos) << r.out;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("flipped 1432 faces"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mixed windings"), std::string::npos) << r.err;
+  const RunResult cow = run("info " + sdfkit::test::data_mesh("cow.off"));
+  ASSERT_EQ(cow.exit_code, 0) << cow.err;
+  EXPECT_NE(cow.out.find("flipped faces:      0"), std::string::npos) << cow.out;
+  EXPECT_EQ(cow.err.find("flipped"), std::string::npos) << cow.err;
+}
+
 TEST_F(Cli, InfoOnBuiltinShape) {
   const RunResult r = run("info builtin:torus");
   ASSERT_EQ(r.exit_code, 0) << r.err;
