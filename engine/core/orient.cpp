@@ -1,5 +1,7 @@
 #include "sdfkit/core/orient.hpp"
 
+#include "sdfkit/core/topology.hpp"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -13,30 +15,6 @@ namespace {
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
 bool degenerate(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[2] == t[0]; }
-
-// Faces around each vertex (vertex -> faces CSR), degenerate faces left out.
-struct VertexFaces {
-  std::vector<std::uint32_t> start;  // per vertex, into `faces`
-  std::vector<std::uint32_t> faces;
-};
-
-VertexFaces faces_by_vertex(const Mesh& mesh) {
-  VertexFaces vf;
-  const std::size_t V = mesh.positions.size();
-  vf.start.assign(V + 1, 0);
-  for (const Triangle& t : mesh.triangles)
-    if (!degenerate(t))
-      for (std::uint32_t v : t) ++vf.start[v + 1];
-  std::partial_sum(vf.start.begin(), vf.start.end(), vf.start.begin());
-  vf.faces.resize(vf.start[V]);
-  std::vector<std::uint32_t> fill(vf.start.begin(), vf.start.end() - 1);
-  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
-    const Triangle& t = mesh.triangles[f];
-    if (degenerate(t)) continue;
-    for (std::uint32_t v : t) vf.faces[fill[v]++] = static_cast<std::uint32_t>(f);
-  }
-  return vf;
-}
 
 // Union-find over faces that also keeps each face's winding relative to its root (parity 1 =
 // wound against it): joining two faces across an edge they use in the same direction asks for
@@ -122,17 +100,17 @@ OrientReport orient_outward(Mesh& mesh) {
   ParityUnionFind uf(F);
   std::vector<std::uint8_t> open_face(F, 0);  // touches a boundary or non-manifold edge
   {
-    const VertexFaces vf = faces_by_vertex(mesh);
+    const Adjacency vf = vertex_faces(mesh, /*skip_degenerate=*/true);
     struct Corner {
       std::uint32_t face, next, prev;
     };
     std::vector<Corner> around;
-    for (std::uint32_t a = 0; a < vf.start.size() - 1; ++a) {
+    for (std::uint32_t a = 0; a < vf.size(); ++a) {
       around.clear();
-      for (std::uint32_t i = vf.start[a]; i < vf.start[a + 1]; ++i) {
-        const Triangle& t = mesh.triangles[vf.faces[i]];
+      for (std::uint32_t i = vf.offsets[a]; i < vf.offsets[a + 1]; ++i) {
+        const Triangle& t = mesh.triangles[vf.indices[i]];
         const int k = t[0] == a ? 0 : (t[1] == a ? 1 : 2);
-        around.push_back({vf.faces[i], t[(k + 1) % 3], t[(k + 2) % 3]});
+        around.push_back({vf.indices[i], t[(k + 1) % 3], t[(k + 2) % 3]});
       }
       for (std::size_t i = 0; i < around.size(); ++i)
         for (const std::uint32_t b : {around[i].next, around[i].prev}) {

@@ -98,6 +98,25 @@ Adjacency face_adjacency(const Mesh& mesh) {
   return from_pairs(mesh.triangles.size(), pairs);
 }
 
+Adjacency vertex_faces(const Mesh& mesh, bool skip_degenerate) {
+  const auto skip = [&](const Triangle& t) { return skip_degenerate && (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]); };
+  const std::size_t n = mesh.positions.size();
+  Adjacency vf;
+  vf.offsets.assign(n + 1, 0);
+  for (const Triangle& t : mesh.triangles)
+    if (!skip(t))
+      for (std::uint32_t v : t) ++vf.offsets[v + 1];
+  std::partial_sum(vf.offsets.begin(), vf.offsets.end(), vf.offsets.begin());
+  vf.indices.resize(vf.offsets[n]);
+  std::vector<std::uint32_t> fill(vf.offsets.begin(), vf.offsets.end() - 1);
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const Triangle& t = mesh.triangles[f];
+    if (skip(t)) continue;
+    for (std::uint32_t v : t) vf.indices[fill[v]++] = static_cast<std::uint32_t>(f);
+  }
+  return vf;
+}
+
 MeshReport analyze(const Mesh& mesh) {
   MeshReport r;
   r.vertices = mesh.positions.size();

@@ -8,6 +8,7 @@
 #include "sdfkit/diffusion/stm.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/topology.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
@@ -273,19 +274,32 @@ std::pair<double, double> singular_values(double a, double b, double c, double d
   return {q + r, std::abs(q - r)};
 }
 
-// σ1 ≥ σ2 of the linear map taking triangle (p0, p1, p2), in its own plane, to the chart points
-// uv (chart units per model unit); nothing for a degenerate triangle.
-std::optional<std::pair<double, double>> face_map_singular_values(const glm::dvec3& p0, const glm::dvec3& p1,
-                                                                  const glm::dvec3& p2, const glm::dvec2 (&uv)[3]) {
+// Triangle (p0, p1, p2) in its own plane: p0 at the origin, p1 on the x axis at l1 = |p1 - p0|,
+// p2 at (ex, ey), ey > 0 on the side the triangle's normal (p1 - p0) × (p2 - p0) sees it
+// counter-clockwise; `twice_area` = |(p1 - p0) × (p2 - p0)|. Nothing for a degenerate triangle
+// (l1 or the area 0).
+struct PlaneTriangle {
+  double l1, ex, ey, twice_area;
+};
+std::optional<PlaneTriangle> in_own_plane(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2) {
   const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
   const double l1 = glm::length(e1), an = glm::length(n);
   if (!(l1 > 0) || !(an > 0)) return std::nullopt;
   const glm::dvec3 ux = e1 / l1, uy = glm::cross(n / an, ux);
+  return PlaneTriangle{l1, glm::dot(e2, ux), glm::dot(e2, uy), an};
+}
+
+// σ1 ≥ σ2 of the linear map taking triangle (p0, p1, p2), in its own plane, to the chart points
+// uv (chart units per model unit); nothing for a degenerate triangle.
+std::optional<std::pair<double, double>> face_map_singular_values(const glm::dvec3& p0, const glm::dvec3& p1,
+                                                                  const glm::dvec3& p2, const glm::dvec2 (&uv)[3]) {
+  const std::optional<PlaneTriangle> q = in_own_plane(p0, p1, p2);
+  if (!q) return std::nullopt;
   // P = [p1 p2] in the triangle's plane, D = [d1 d2] in the chart: J = D P^-1, with
   // P^-1 = [[1/l1, -ex/(l1 ey)], [0, 1/ey]].
-  const double ex = glm::dot(e2, ux), ey = glm::dot(e2, uy);
   const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
-  const double j11 = d1.x / l1, j21 = d1.y / l1, j12 = (d2.x - ex * j11) / ey, j22 = (d2.y - ex * j21) / ey;
+  const double j11 = d1.x / q->l1, j21 = d1.y / q->l1;
+  const double j12 = (d2.x - q->ex * j11) / q->ey, j22 = (d2.y - q->ex * j21) / q->ey;
   return singular_values(j11, j12, j21, j22);
 }
 
@@ -899,15 +913,9 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
   // chart's own faces are and does not stretch: where the map folds (a planar chart reaching
   // around a limb, a bone chart past its end) the band stops.
   if (options.overlap > 0) {
-    std::vector<std::uint32_t> vf_start(V + 1, 0), vf(3 * F);
-    for (const Triangle& t : mesh.triangles)
-      for (std::uint32_t v : t) ++vf_start[v + 1];
-    for (std::size_t i = 0; i < V; ++i) vf_start[i + 1] += vf_start[i];
-    {
-      std::vector<std::uint32_t> fill(vf_start.begin(), vf_start.end() - 1);
-      for (std::size_t f = 0; f < F; ++f)
-        for (std::uint32_t v : mesh.triangles[f]) vf[fill[v]++] = static_cast<std::uint32_t>(f);
-    }
+    const Adjacency faces_around = vertex_faces(mesh);
+    const std::vector<std::uint32_t>& vf_start = faces_around.offsets;
+    const std::vector<std::uint32_t>& vf = faces_around.indices;
     std::vector<std::vector<std::uint32_t>> chart_vertices(maps.size());
     for (std::size_t v = 0; v < V; ++v) chart_vertices[vchart[v]].push_back(static_cast<std::uint32_t>(v));
     std::vector<double> dist(V, std::numeric_limits<double>::infinity());
@@ -1008,6 +1016,15 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       }
       const double span = pa == kNone || pb == kNone ? 0.0 : glm::length(glm::dvec3(mesh.positions[pb]) - glm::dvec3(mesh.positions[pa]));
       if (!(span > 0)) return false;
+      // Whether each domain face is oriented like the chart's own faces in the projection: a face
+      // touching the chart that the projection already flipped has no say below.
+      std::vector<std::uint8_t> says(domain.size());
+      for (std::size_t i = 0; i < domain.size(); ++i) {
+        const Triangle& t = mesh.triangles[domain[i]];
+        glm::dvec2 pr[3];
+        for (int k = 0; k < 3; ++k) pr[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
+        says[i] = orientation * signed_area2(pr[0], pr[1], pr[2]) > 0;
+      }
       std::vector<std::uint32_t> verts, bad;
       const auto cleanup = [&] {
         for (std::uint32_t v : verts) lscm_index[v] = -1;
@@ -1028,14 +1045,11 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         std::int32_t row = 0;
         for (std::uint32_t f : domain) {
           const Triangle& t = mesh.triangles[f];
-          const glm::dvec3 p0(mesh.positions[t[0]]), e1 = glm::dvec3(mesh.positions[t[1]]) - p0,
-              e2 = glm::dvec3(mesh.positions[t[2]]) - p0;
-          const glm::dvec3 nrm = glm::cross(e1, e2);
-          const double l1 = glm::length(e1), an = glm::length(nrm);
-          if (!(l1 > 0) || !(an > 1e-14 * l1 * l1)) continue;
-          const glm::dvec3 ux = e1 / l1, uy = glm::cross(nrm / an, ux);
-          const glm::dvec2 q[3] = {{0, 0}, {l1, 0}, {glm::dot(e2, ux), glm::dot(e2, uy)}};
-          const double w = 1.0 / std::sqrt(an);  // an = twice the area
+          const std::optional<PlaneTriangle> pt = in_own_plane(
+              glm::dvec3(mesh.positions[t[0]]), glm::dvec3(mesh.positions[t[1]]), glm::dvec3(mesh.positions[t[2]]));
+          if (!pt || !(pt->twice_area > 1e-14 * pt->l1 * pt->l1)) continue;
+          const glm::dvec2 q[3] = {{0, 0}, {pt->l1, 0}, {pt->ex, pt->ey}};
+          const double w = 1.0 / std::sqrt(pt->twice_area);
           double re = 0, im = 0;
           for (int j = 0; j < 3; ++j) {
             const glm::dvec2 wj = q[(j + 2) % 3] - q[(j + 1) % 3];
@@ -1069,26 +1083,21 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
           return i == ia ? glm::dvec2(0.0) : i == ib ? glm::dvec2(span, 0.0) : glm::dvec2(x[2 * column(i)], x[2 * column(i) + 1]);
         };
         // The orientation of the chart's own faces (up to a mirror, the projection's), and the
-        // faces that turn against it, are squashed or stretched. A face touching the chart that
-        // its projection already flipped has no say.
+        // faces that turn against it, are squashed or stretched.
         const auto own_face = [&](const Triangle& t) { return vchart[t[0]] == c || vchart[t[1]] == c || vchart[t[2]] == c; };
-        const auto projected_ok = [&](const Triangle& t) {
-          glm::dvec2 pr[3];
-          for (int k = 0; k < 3; ++k) pr[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
-          return orientation * signed_area2(pr[0], pr[1], pr[2]) > 0;
-        };
         double votes = 0;
-        for (std::uint32_t f : domain) {
-          const Triangle& t = mesh.triangles[f];
-          if (!own_face(t) || !projected_ok(t)) continue;
+        for (std::size_t i = 0; i < domain.size(); ++i) {
+          const Triangle& t = mesh.triangles[domain[i]];
+          if (!own_face(t) || !says[i]) continue;
           votes += signed_area2(coord(t[0]), coord(t[1]), coord(t[2])) > 0 ? 1 : -1;
         }
         const double flip = votes >= 0 ? 1.0 : -1.0;
         bad.clear();
         bool own_bad = false;
-        for (std::uint32_t f : domain) {
+        for (std::size_t i = 0; i < domain.size(); ++i) {
+          const std::uint32_t f = domain[i];
           const Triangle& t = mesh.triangles[f];
-          if (!projected_ok(t)) continue;
+          if (!says[i]) continue;
           const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
           bool fine = flip * signed_area2(uv[0], uv[1], uv[2]) > 0;
           const auto sv = face_map_singular_values(glm::dvec3(mesh.positions[t[0]]), glm::dvec3(mesh.positions[t[1]]),
@@ -1104,9 +1113,11 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         if (!bad.empty()) {
           if (round == 3) return cleanup(), false;
           std::sort(bad.begin(), bad.end());
-          domain.erase(std::remove_if(domain.begin(), domain.end(),
-                                      [&](std::uint32_t f) { return std::binary_search(bad.begin(), bad.end(), f); }),
-                       domain.end());
+          std::size_t kept = 0;
+          for (std::size_t i = 0; i < domain.size(); ++i)
+            if (!std::binary_search(bad.begin(), bad.end(), domain[i])) domain[kept] = domain[i], says[kept++] = says[i];
+          domain.resize(kept);
+          says.resize(kept);
           trimmed.insert(trimmed.end(), bad.begin(), bad.end());
           continue;
         }

@@ -26,6 +26,11 @@ Adjacency vertex_adjacency(const Mesh& mesh, std::span<const std::uint8_t> rings
 // Faces sharing an edge (two common vertices) with each face, sorted.
 Adjacency face_adjacency(const Mesh& mesh);
 
+// The faces around each vertex, in face order, one entry per corner (a face that repeats a vertex
+// is listed once per repeat). With `skip_degenerate`, faces with a repeated index are left out.
+// Indices out of range are not checked (validate_mesh first).
+Adjacency vertex_faces(const Mesh& mesh, bool skip_degenerate = false);
+
 struct MeshReport {
   std::size_t vertices = 0;
   std::size_t faces = 0;
