@@ -11,28 +11,19 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "mesh_text.hpp"
 #include "scratch.hpp"
 
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 using namespace sdfkit;
 namespace dif = sdfkit::diffusion;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string off_text(const Mesh& m) {
-  std::ostringstream o;
-  o.precision(9);
-  o << "OFF\n" << m.positions.size() << ' ' << m.triangles.size() << " 0\n";
-  for (const glm::vec3& p : m.positions) o << p.x << ' ' << p.y << ' ' << p.z << '\n';
-  for (const Triangle& t : m.triangles) o << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
-  return o.str();
-}
 
 // A capsule along z with a hand-made skeleton: one bone and two caps, so faces at the caps'
 // borders have corners in two charts.
@@ -42,7 +33,7 @@ struct Fixture {
   dif::Stm stm;
   SdfField field;
   Fixture() {
-    asset = io::load_asset(dir.write("capsule.off", off_text(shapes::capsule(0.5f, 3.0f, 32, 24))));
+    asset = io::load_asset(dir.write("capsule.off", test::off_text(shapes::capsule(0.5f, 3.0f, 32, 24))));
     skeleton::Skeleton s;
     for (int i = 0; i <= 6; ++i) s.nodes.push_back({{0.0f, 0.0f, -1.5f + 0.5f * static_cast<float>(i)}, 0.5f, {}, false});
     for (std::uint32_t i = 0; i < 6; ++i) s.edges.push_back({i, i + 1});

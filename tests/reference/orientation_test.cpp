@@ -2,6 +2,7 @@
 // meshes) or inside out gives the SDF of the solid it bounds: load_asset orients the welded mesh
 // (orient_outward), so the values equal those of the same file wound right. The control: the
 // same faces computed as given are far off.
+#include "mesh_text.hpp"
 #include "scratch.hpp"
 
 #include "sdfkit/core/sdf.hpp"
@@ -14,20 +15,10 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <sstream>
 
 using namespace sdfkit;
 
 namespace {
-
-std::string off_text(const Mesh& m) {
-  std::ostringstream s;
-  s.precision(9);
-  s << "OFF\n" << m.positions.size() << ' ' << m.triangles.size() << " 0\n";
-  for (const glm::vec3& p : m.positions) s << p.x << ' ' << p.y << ' ' << p.z << '\n';
-  for (const Triangle& t : m.triangles) s << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
-  return s.str();
-}
 
 std::vector<float> sdf_of(const Mesh& m) {
   reference::EmbreeBackend backend;
@@ -57,7 +48,7 @@ TEST(Orientation, MixedAndInvertedWindingsGiveTheSolidsSdf) {
   for (Triangle& t : inside_out.triangles) std::swap(t[1], t[2]);
 
   for (const auto& [name, bad] : {std::pair{"mixed.off", mixed}, std::pair{"inside_out.off", inside_out}}) {
-    const io::Asset a = io::load_asset(dir.write(name, off_text(bad)));
+    const io::Asset a = io::load_asset(dir.write(name, test::off_text(bad)));
     ASSERT_EQ(a.mesh.positions.size(), good.positions.size()) << name;
     EXPECT_EQ(a.mesh.triangles, good.triangles) << name;
     EXPECT_GT(a.flipped_faces, 0u) << name;
