@@ -100,6 +100,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: give mesh files or --models\n");
     return 2;
   }
+  if (no_band && no_conformal) {  // the conformal maps are made over the band: nothing to turn off
+    std::fprintf(stderr, "error: --no-conformal has no effect with --no-band (charts without a band keep their projections)\n");
+    return 2;
+  }
   for (std::size_t at = 0; at <= sigma_list.size();) {
     const std::size_t end = std::min(sigma_list.find(',', at), sigma_list.size());
     const std::string item = sigma_list.substr(at, end - at);
