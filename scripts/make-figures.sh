@@ -10,6 +10,9 @@
 #   skeleton_man.png        CGAL's man.off (a human)
 #   skeleton_camel.png      CGAL's camel.off (a quadruped)
 #   skeleton_elephant.png   CGAL's elephant.off (genus 3: three cycles)
+#   skeleton_armadillo.png  CGAL's armadillo.off (a humanoid: curves down every limb, no sheet)
+#   skeleton_boeing.png     CGAL's boeing.off (a thin-walled rib: sheets on its flanges, the
+#                           one mesh of the data set judged sheet-like besides the C and S plates)
 #   worm_frame.png          frame 50 of the Sibernetic worm (tests/data/worm): its surface points
 #                           and the 16-segment polyline of `sdfkit pointcloud-skeleton`
 #   worm_strip.png          6 frames of the worm with their polylines side by side (Figure 15)
@@ -27,7 +30,8 @@ WORM=tests/data/worm
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 mkdir -p "$OUT"
-tar -xzf "$CGAL_DATA" -C "$WORK" --strip-components=2 data/meshes/man.off data/meshes/camel.off data/meshes/elephant.off
+tar -xzf "$CGAL_DATA" -C "$WORK" --strip-components=2 data/meshes/man.off data/meshes/camel.off data/meshes/elephant.off \
+  data/meshes/armadillo.off data/meshes/boeing.off
 
 # Skeletons: `sdfkit skeleton`, then the mesh (SDF colours, faded) with curves, sheets, branch
 # nodes and leaves in their own colours; the longest axis up (OFF files say nothing about up).
@@ -43,6 +47,8 @@ skeleton_picture man "$WORK/man.off"
 # The camel's z extent beats its y by 2 %: the rule would lay it on its side; its file is +y up.
 skeleton_picture camel "$WORK/camel.off" --up y
 skeleton_picture elephant "$WORK/elephant.off"
+skeleton_picture armadillo "$WORK/armadillo.off"
+skeleton_picture boeing "$WORK/boeing.off"
 
 # The worm: polylines of all 100 frames (the same end first in every frame), one frame, a strip.
 "$SDFKIT" pointcloud-skeleton "$WORM" -o "$WORK/worm.json" --segments 16

@@ -342,27 +342,39 @@ constexpr std::size_t kNearestNodes = 8;
 // (fraction of the bbox diagonal) ...
 constexpr double kRegionCell = 0.05;
 // ... and a piece is flat (part of a sheet) when the second principal spread of its centre
-// points exceeds this fraction of the first.
+// points exceeds this fraction of the first, and around it the region's centre points spread in
+// a second direction further than the solid is thick there (see split_region).
 constexpr double kFlatRatio = 0.25;
 // A flat region becomes a sheet only when it holds at least this share of the surface's
 // vertices; a smaller one (a palm, a fist, a flat ear's tip) gets curve nodes.
 constexpr double kSheetRegionShare = 0.05;
 
-// lambda_2 / lambda_1 of a symmetric positive semi-definite 3x3 matrix (0 when it is zero).
-double second_eigenvalue_ratio(const glm::dmat3& a) {
+// Eigenvalues of a symmetric positive semi-definite 3x3 matrix, largest first (trigonometric
+// solution).
+std::array<double, 3> symmetric_eigenvalues(const glm::dmat3& a) {
   const double p1 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
   const double q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
   const double p2 = (a[0][0] - q) * (a[0][0] - q) + (a[1][1] - q) * (a[1][1] - q) +
                     (a[2][2] - q) * (a[2][2] - q) + 2.0 * p1;
   const double p = std::sqrt(p2 / 6.0);
-  if (!(p > 0.0)) return q > 0.0 ? 1.0 : 0.0;
+  if (!(p > 0.0)) return {q, q, q};
   const glm::dmat3 b = (1.0 / p) * (a - q * glm::dmat3(1.0));
   const double r = std::clamp(glm::determinant(b) / 2.0, -1.0, 1.0);
   const double phi = std::acos(r) / 3.0;
   const double e1 = q + 2.0 * p * std::cos(phi);
   const double e3 = q + 2.0 * p * std::cos(phi + 2.0943951023931953);
-  const double e2 = 3.0 * q - e1 - e3;
-  return e1 > 0.0 ? std::max(0.0, e2) / e1 : 0.0;
+  return {e1, 3.0 * q - e1 - e3, e3};
+}
+
+// Covariance of points (divided by their count) and their mean.
+template <class Points>
+std::pair<glm::dmat3, glm::dvec3> covariance(const Points& points) {
+  glm::dvec3 m(0.0);
+  for (const glm::dvec3& p : points) m += p;
+  m /= static_cast<double>(std::max<std::size_t>(1, points.size()));
+  glm::dmat3 c(0.0);
+  for (const glm::dvec3& p : points) c += glm::outerProduct(p - m, p - m);
+  return {c / static_cast<double>(std::max<std::size_t>(1, points.size())), m};
 }
 
 void validate(const SkeletonOptions& o) {
@@ -533,11 +545,26 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   };
   // `region` split into pieces of connected vertices whose centre points share a cell of
   // kRegionCell * diag (in the order of their first vertex), and whether it is mostly flat:
-  // pieces of >= 4 vertices whose centre points spread in two directions (lambda_2 / lambda_1 >
-  // kFlatRatio) hold over half of those pieces' vertices.
+  // flat pieces of >= 4 vertices hold over half of those pieces' vertices. A piece is flat when
+  //   - its centre points spread in two directions (lambda_2 / lambda_1 > kFlatRatio), and
+  //   - the region's centre points within twice the piece's thickness t of its mean spread in
+  //     their second principal direction over more than t (sqrt(12 lambda_2), a uniform
+  //     spread's length). That is "wider than thick": a plate's mid-surface fills the ball in
+  //     two directions (a disc: 3.5 t across; at the plate's rim half a disc: 1.8 t), a limb's
+  //     centre points lie along its axis (an elliptic limb's, along a segment that is longer
+  //     than the limb is thick only where the section is over twice as wide as thick). The cell
+  //     alone cannot say it: it caps the first spread at the cell, so a limb about as thick as
+  //     the cell looks as round as a plate (the armadillo's forearm became a sheet). The thickness
+  //     t is twice the mean distance from a vertex to its centre point (the SDF where the
+  //     centre point came from it).
   struct Pieces {
     std::vector<std::vector<std::uint32_t>> pieces;
     bool mostly_flat = false;
+  };
+  auto cell_key = [](const glm::dvec3& q, double cell) {
+    return std::array<std::int64_t, 3>{static_cast<std::int64_t>(std::floor(q.x / cell)),
+                                       static_cast<std::int64_t>(std::floor(q.y / cell)),
+                                       static_cast<std::int64_t>(std::floor(q.z / cell))};
   };
   auto split_region = [&](const std::vector<std::uint32_t>& region) {
     const double cell = kRegionCell * diag;
@@ -545,10 +572,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     std::vector<std::uint32_t> cell_of(region.size());
     std::map<std::uint32_t, std::uint32_t> slot;  // vertex -> index in region
     for (std::uint32_t i = 0; i < region.size(); ++i) {
-      const glm::vec3 q = surface.centre[region[i]];
-      const std::array<std::int64_t, 3> key{static_cast<std::int64_t>(std::floor(q.x / cell)),
-                                            static_cast<std::int64_t>(std::floor(q.y / cell)),
-                                            static_cast<std::int64_t>(std::floor(q.z / cell))};
+      const std::array<std::int64_t, 3> key = cell_key(glm::dvec3(surface.centre[region[i]]), cell);
       cell_of[i] = cell_index.try_emplace(key, static_cast<std::uint32_t>(cell_index.size())).first->second;
       slot[region[i]] = i;
     }
@@ -566,22 +590,36 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       if (inserted) piece_order.push_back(pieces.find(i));
       it->second.push_back(region[i]);
     }
+    // The region's centre points on a grid of the same cell, for the balls around the pieces.
+    std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> region_cells;
+    for (std::uint32_t k : region) region_cells[cell_key(glm::dvec3(surface.centre[k]), cell)].push_back(k);
     double flat = 0.0, total = 0.0;
     for (std::uint32_t r : piece_order) {
       const std::vector<std::uint32_t>& piece = piece_members[r];
       if (piece.size() < 4) continue;
-      glm::dvec3 m(0.0);
-      for (std::uint32_t k : piece) m += glm::dvec3(surface.centre[k]);
-      m /= static_cast<double>(piece.size());
-      glm::dmat3 cov(0.0);
-      for (std::uint32_t k : piece) {
-        const glm::dvec3 d = glm::dvec3(surface.centre[k]) - m;
-        cov += glm::outerProduct(d, d);
-      }
-      // Eigenvalues of the symmetric 3x3 covariance (trigonometric solution).
-      const double l2 = second_eigenvalue_ratio(cov);
       total += static_cast<double>(piece.size());
-      if (l2 > kFlatRatio) flat += static_cast<double>(piece.size());
+      std::vector<glm::dvec3> points;
+      double thickness = 0.0;
+      for (std::uint32_t k : piece) {
+        points.push_back(glm::dvec3(surface.centre[k]));
+        thickness += 2.0 * glm::length(glm::dvec3(original.positions[k]) - points.back());
+      }
+      thickness /= static_cast<double>(piece.size());
+      const auto [piece_cov, mean] = covariance(points);
+      const std::array<double, 3> e = symmetric_eigenvalues(piece_cov);
+      if (!(e[0] > 0.0) || !(e[1] / e[0] > kFlatRatio)) continue;
+      const double reach = 2.0 * thickness;
+      points.clear();
+      const auto lo = cell_key(mean - glm::dvec3(reach), cell), hi = cell_key(mean + glm::dvec3(reach), cell);
+      for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+            if (const auto it = region_cells.find({x, y, z}); it != region_cells.end())
+              for (std::uint32_t k : it->second)
+                if (glm::length(glm::dvec3(surface.centre[k]) - mean) <= reach) points.push_back(glm::dvec3(surface.centre[k]));
+      if (points.size() < 4) continue;
+      const double spread = std::sqrt(12.0 * std::max(0.0, symmetric_eigenvalues(covariance(points).first)[1]));
+      if (spread > thickness) flat += static_cast<double>(piece.size());
     }
     Pieces out;
     for (std::uint32_t r : piece_order) out.pieces.push_back(std::move(piece_members[r]));

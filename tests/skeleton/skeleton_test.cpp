@@ -203,6 +203,7 @@ TEST(Skeleton, SheetsMakeTheCAndSShapesFullyReliable) {
     EXPECT_FALSE(sheets.sheet_triangles.empty());
     EXPECT_EQ(parts(curves), 1);
     EXPECT_EQ(parts(sheets), 1);  // curve and sheet are joined where they touch
+    EXPECT_EQ(sk::cycle_count(sheets), 0);  // genus 0: the sheets' triangles close no cycle
     expect_partition_and_inside(plate.mesh, sheets);
   }
 }
