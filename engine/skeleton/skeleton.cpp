@@ -1268,11 +1268,15 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
     }
   }
-  // Terminal branches inside their junction's ball: a branch (a leaf and the chain of degree-2
-  // curve nodes up to the first node of degree >= 3) whose every node's ball lies inside the
-  // junction's ball describes no part of the solid that the junction's ball does not; it is a
-  // bump of the surface, not a limb. Such branches are
-  // merged into their junction, the one with the deepest ball first, while the junction keeps
+  // Terminal branches covered by the rest of the skeleton: a branch (a leaf and the chain of
+  // degree-2 curve nodes up to the first node of degree >= 3) whose every node's ball lies in
+  // the union of the other curve nodes' balls describes no part of the solid that the rest of
+  // the skeleton does not; it is a bump of the surface or a spur beside a limb's own curve,
+  // not a limb. A ball counts as covered when its centre and 26 points on its sphere (the
+  // directions of a 3x3x3 grid) each lie in another node's ball. (Until 2026-11-29 only the
+  // junction's ball counted; spurs beside a limb, whose balls the neighbouring nodes of the
+  // limb cover together but no single ball does, stayed.) Such branches are merged into their
+  // junction, the one that reaches least out of the union first, while the junction keeps
   // degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
   if (options.prune_branches) {
     std::vector<std::uint8_t> dead(sk.nodes.size(), 0);
@@ -1281,10 +1285,11 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
       for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
       struct Branch {
-        float excess;  // max over the branch's nodes of |node - junction| + r_node - r_junction
+        float excess;  // how far the branch's balls reach out of the other nodes' (< 0: inside)
         std::uint32_t leaf, junction;
         std::vector<std::uint32_t> path;
       };
+      std::vector<std::uint8_t> on_path(sk.nodes.size(), 0);
       std::vector<Branch> branches;
       for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
         if (dead[leaf] || adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet) continue;
@@ -1296,10 +1301,28 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
           prev = cur, cur = next;
         }
         if (adjacency[cur].size() < 3 || sk.nodes[cur].sheet) continue;
-        const Node& j = sk.nodes[cur];
+        for (std::uint32_t k : path) on_path[k] = 1;
         float excess = -std::numeric_limits<float>::infinity();
-        for (std::uint32_t k : path)
-          excess = std::max(excess, glm::length(sk.nodes[k].position - j.position) + sk.nodes[k].radius - j.radius);
+        for (std::size_t i = 0; i < path.size() && excess < 0.0f; ++i) {
+          const Node& a = sk.nodes[path[i]];
+          // The other curve nodes whose balls meet this one's: only they can cover it.
+          std::vector<std::uint32_t> near;
+          for (std::uint32_t m = 0; m < sk.nodes.size(); ++m)
+            if (!on_path[m] && !dead[m] && !sk.nodes[m].sheet && !sk.nodes[m].vertices.empty() &&
+                glm::length(sk.nodes[m].position - a.position) < a.radius + sk.nodes[m].radius)
+              near.push_back(m);
+          for (int dx = -1; dx <= 1 && excess < 0.0f; ++dx)
+            for (int dy = -1; dy <= 1 && excess < 0.0f; ++dy)
+              for (int dz = -1; dz <= 1 && excess < 0.0f; ++dz) {
+                const glm::vec3 d(static_cast<float>(dx), static_cast<float>(dy), static_cast<float>(dz));
+                const glm::vec3 q = d == glm::vec3(0.0f) ? a.position : a.position + a.radius * glm::normalize(d);
+                float outside = std::numeric_limits<float>::infinity();
+                for (std::uint32_t m : near)
+                  outside = std::min(outside, glm::length(q - sk.nodes[m].position) - sk.nodes[m].radius);
+                excess = std::max(excess, outside);
+              }
+        }
+        for (std::uint32_t k : path) on_path[k] = 0;
         if (excess < 0.0f) branches.push_back({excess, leaf, cur, std::move(path)});
       }
       std::sort(branches.begin(), branches.end(), [](const Branch& a, const Branch& b) {
