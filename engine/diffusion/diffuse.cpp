@@ -109,11 +109,13 @@ DiffuseOptions step_options(const DiffuseOptions& o, std::uint32_t steps) {
 
 // DiffuseOptions::steps = 0: the fewest steps whose kernel (kBandSigmas step widths) fits inside
 // the coverage around the typical vertex (the median over the vertices of what each needs,
-// AtlasMapping::vertex_reach), but no step narrower than the mesh's area-weighted RMS edge length
-// (sqrt(8 · interpolation_variance)): the variance the road takes off for the interpolation is
-// the triangle's mean of E(x), which holds for a kernel spanning triangles; a narrower one reads
-// less of it (none at all at a vertex), so steps finer than the triangles would blur too little,
-// and each costs a whole blur. 1 without a reach.
+// AtlasMapping::vertex_reach), but no step whose variance is below the mesh's interpolation
+// variance (area-weighted mean of E(x), see triangle_blur_variance): that much of each step's
+// variance the road itself adds, and the blur takes it off, so a narrower step would leave the
+// typical triangle nothing to blur with and only repeat the interpolation. 1 without a reach.
+// (Until 2026-11-29 the floor was the RMS edge, a variance of 8 E: on coarse meshes whose bands
+// are short (pipe, joint, oblong, pinion: long triangles, charts as large as the kernel) it held
+// the steps at 1-2 where the kernel needed tens to carry across the charts; bench/RESULTS.md.)
 std::uint32_t auto_steps(const Mesh& mesh, const AtlasMapping& mapping, const DiffuseOptions& o, double interp_variance) {
   const std::size_t V = mesh.vertex_count();
   if (mapping.vertex_reach.size() != V || V == 0) return 1;
@@ -125,8 +127,8 @@ std::uint32_t auto_steps(const Mesh& mesh, const AtlasMapping& mapping, const Di
     need[v] = reach > 0.0 ? std::pow(kBandSigmas * width[v] / reach, 2.0) : static_cast<double>(kMaxSteps);
   }
   const double typical = quantile(std::move(need), 0.5);
-  const double rms_edge = std::sqrt(8.0 * interp_variance);
-  const double finest = rms_edge > 0.0 ? std::floor(std::pow(quantile(std::move(width), 0.5) / rms_edge, 2.0)) : 1.0;
+  const double finest =
+      interp_variance > 0.0 ? std::floor(std::pow(quantile(std::move(width), 0.5), 2.0) / interp_variance) : 1.0;
   const double n = std::min({std::ceil(typical - 1e-9), finest, static_cast<double>(kMaxSteps)});
   return static_cast<std::uint32_t>(std::max(n, 1.0));
 }
