@@ -611,12 +611,23 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       const double reach = 2.0 * thickness;
       points.clear();
       const auto lo = cell_key(mean - glm::dvec3(reach), cell), hi = cell_key(mean + glm::dvec3(reach), cell);
-      for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-          for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
-            if (const auto it = region_cells.find({x, y, z}); it != region_cells.end())
-              for (std::uint32_t k : it->second)
-                if (glm::length(glm::dvec3(surface.centre[k]) - mean) <= reach) points.push_back(glm::dvec3(surface.centre[k]));
+      const auto gather = [&](const std::vector<std::uint32_t>& members_of_cell) {
+        for (std::uint32_t k : members_of_cell)
+          if (glm::length(glm::dvec3(surface.centre[k]) - mean) <= reach) points.push_back(glm::dvec3(surface.centre[k]));
+      };
+      const double box_cells = static_cast<double>(hi[0] - lo[0] + 1) * static_cast<double>(hi[1] - lo[1] + 1) *
+                               static_cast<double>(hi[2] - lo[2] + 1);
+      if (box_cells > static_cast<double>(region_cells.size())) {
+        // A ball wider than the region's cells (a thick part): visit the occupied cells instead.
+        for (const auto& [key, members_of_cell] : region_cells)
+          if (key[0] >= lo[0] && key[0] <= hi[0] && key[1] >= lo[1] && key[1] <= hi[1] && key[2] >= lo[2] && key[2] <= hi[2])
+            gather(members_of_cell);
+      } else {
+        for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+          for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+            for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+              if (const auto it = region_cells.find({x, y, z}); it != region_cells.end()) gather(it->second);
+      }
       if (points.size() < 4) continue;
       const double spread = std::sqrt(12.0 * std::max(0.0, symmetric_eigenvalues(covariance(points).first)[1]));
       if (spread > thickness) flat += static_cast<double>(piece.size());
