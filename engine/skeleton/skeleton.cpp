@@ -605,8 +605,9 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         thickness += 2.0 * glm::length(glm::dvec3(original.positions[k]) - points.back());
       }
       thickness /= static_cast<double>(piece.size());
-      const auto [piece_cov, mean] = covariance(points);
-      const std::array<double, 3> e = symmetric_eigenvalues(piece_cov);
+      const std::pair<glm::dmat3, glm::dvec3> piece_cov = covariance(points);
+      const glm::dvec3 mean = piece_cov.second;  // a plain variable: lambdas below capture it
+      const std::array<double, 3> e = symmetric_eigenvalues(piece_cov.first);
       if (!(e[0] > 0.0) || !(e[1] / e[0] > kFlatRatio)) continue;
       const double reach = 2.0 * thickness;
       points.clear();
