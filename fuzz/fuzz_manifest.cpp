@@ -6,28 +6,17 @@
 #include "sdfkit/batch.hpp"
 #include "sdfkit/core/error.hpp"
 
+#include "private_dir.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
-#include <system_error>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  // A private directory, removed when the process exits (a run that crashes keeps it).
-  static std::string created;
-  static const std::string dir = [] {
-    char d[] = "/tmp/sdfkit-fuzz-manifest-XXXXXX";
-    if (mkdtemp(d) == nullptr) std::abort();
-    created = d;
-    std::atexit([] {
-      std::error_code ignored;
-      std::filesystem::remove_all(created, ignored);
-    });
-    return std::string(d);
-  }();
+  const std::string& dir = sdfkit::fuzz::private_dir("/tmp/sdfkit-fuzz-manifest-XXXXXX");
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   if (text.find('/') != std::string_view::npos || text.find("..") != std::string_view::npos)
     return -1;  // not added to the corpus

@@ -4,6 +4,7 @@
 // refuses must be an InputError; anything else (a crash, a sanitizer report, another exception,
 // a hang) is a finding.
 
+#include "private_dir.hpp"
 #include "readers.hpp"  // engine/io: load_from_memory
 
 #include <cstddef>
@@ -12,29 +13,13 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
-#include <system_error>
 
 namespace sdfkit::fuzz {
-
-// The private directory of this process, removed when it exits (a run that crashes keeps it).
-inline std::string& private_dir() {
-  static std::string dir;
-  return dir;
-}
 
 // A path inside an empty private directory: a glTF's relative references resolve there (and
 // find nothing), so a run never reads the machine's files.
 inline const std::string& input_path(const char* extension) {
-  static const std::string path = [&] {
-    char dir[] = "/tmp/sdfkit-fuzz-XXXXXX";
-    if (mkdtemp(dir) == nullptr) std::abort();
-    private_dir() = dir;
-    std::atexit([] {
-      std::error_code ignored;
-      std::filesystem::remove_all(private_dir(), ignored);
-    });
-    return std::string(dir) + "/input" + extension;
-  }();
+  static const std::string path = private_dir("/tmp/sdfkit-fuzz-XXXXXX") + "/input" + extension;
   return path;
 }
 
