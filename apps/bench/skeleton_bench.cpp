@@ -3,11 +3,16 @@
 // same meshes, in the same run. Prints a Markdown table.
 //
 // usage: sdfkit_skeleton_bench [--backend opencl|embree] [--runs N] [MESH.off ...]
-//        sdfkit_skeleton_bench [--backend ...] --eval DIR [--filter TEXT] [--dump DIR] [--cgal-from DIR]
-//                              [--max-vertices N] [--no-sdf-off] [--no-models]
+//        sdfkit_skeleton_bench [--backend ...] --eval DIR [--filter TEXT] [--dump DIR]
+//                              [--cgal-from DIR | --cgal-remesh PCT] [--max-vertices N]
+//                              [--no-sdf-off] [--no-models]
 //   --eval     the evaluation (skeleton_eval.cpp): every closed mesh under DIR (CGAL's data set:
 //              the build tree's skeleton_eval_data) up to --max-vertices (100000) vertices plus
 //              the procedural models, with the SDF terms on and off, beside CGAL's MCF
+//   --dump     write our skeletons and CGAL's as OBJ files into DIR (created)
+//   --cgal-from  read CGAL's skeletons from an earlier --dump instead of computing them
+//   --cgal-remesh  give CGAL an isotropically remeshed copy (edges PCT % of the diagonal): on
+//              coarse CAD meshes MCF on the mesh as it is collapses to a stub
 //   --backend  the SDF backend: the engine's OpenCL ray caster (the default when built and a
 //              device works; PoCL on a CPU) or the Embree CPU reference
 //   --runs     run each side N times and report the fastest (default 1)
@@ -34,6 +39,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <system_error>
 #include <memory>
 #include <string>
 #include <vector>
@@ -155,6 +161,14 @@ int main(int argc, char** argv) {
       eval.dump = argv[++i];
     } else if (arg == "--cgal-from" && i + 1 < argc) {
       eval.cgal_dir = argv[++i];
+    } else if (arg == "--cgal-remesh" && i + 1 < argc) {
+      char* end = nullptr;
+      eval.cgal_remesh = std::strtod(argv[++i], &end) / 100.0;
+      if (*end != '\0' || !(eval.cgal_remesh > 0.0 && eval.cgal_remesh < 1.0)) {
+        std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-remesh %s: expected a percentage of the diagonal in (0, 100)\n",
+                     argv[i]);
+        return 2;
+      }
     } else if (arg == "--max-vertices" && i + 1 < argc) {
       eval.max_vertices = std::strtoul(argv[++i], nullptr, 10);
     } else if (arg == "--no-sdf-off") {
@@ -168,13 +182,28 @@ int main(int argc, char** argv) {
     } else if (arg.rfind("--", 0) == 0) {
       std::fprintf(stderr, "usage: sdfkit_skeleton_bench [--backend opencl|embree] [--runs N] [MESH.off ...]\n"
                            "       sdfkit_skeleton_bench [--backend opencl|embree] --eval DIR [--filter TEXT] "
-                           "[--dump DIR] [--cgal-from DIR] [--max-vertices N] [--no-sdf-off] [--no-models]\n");
+                           "[--dump DIR] [--cgal-from DIR | --cgal-remesh PCT] [--max-vertices N] [--no-sdf-off] [--no-models]\n");
       return 2;
     } else {
       paths.push_back(arg);
     }
   }
   // A directory of CGAL skeletons that is not there would turn every mesh's row into an error.
+  if (!eval.cgal_dir.empty() && eval.cgal_remesh > 0.0) {
+    std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-remesh has no effect with --cgal-from (CGAL's skeletons are read, not computed)\n");
+    return 2;
+  }
+  // The dumps are written one file per mesh as the run goes: the directory must exist first, or
+  // every write would fail silently after minutes of work.
+  if (!eval.dump.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(eval.dump, ec);
+    if (ec || !std::filesystem::is_directory(eval.dump)) {
+      std::fprintf(stderr, "sdfkit_skeleton_bench: --dump %s: cannot create the directory (%s)\n", eval.dump.c_str(),
+                   ec ? ec.message().c_str() : "not a directory");
+      return 2;
+    }
+  }
   if (!eval.cgal_dir.empty() && !std::filesystem::is_directory(eval.cgal_dir)) {
     std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-from %s: no such directory (write one with --dump)\n",
                  eval.cgal_dir.c_str());

@@ -19,6 +19,12 @@ struct SkeletonEvalArgs {
   // CGAL skeleton (CGAL's MCF differs from run to run); CGAL's time is then not known ("–").
   std::string cgal_dir;
   bool procedural = true;             // also evaluate the procedural models
+  // When > 0: CGAL gets an isotropically remeshed copy of each mesh (target edge length this
+  // fraction of the bounding-box diagonal, or the mesh's mean edge length where that is
+  // shorter; CGAL's isotropic_remeshing) instead of the mesh as it is: MCF moves vertices along
+  // the surface's own triangles, and on a coarse CAD mesh (a box of 8 vertices) it collapses to
+  // a stub. CGAL's time is then its MCF's on the denser mesh (remeshing not timed).
+  double cgal_remesh = 0.0;
 };
 
 // Prints the per-mesh table, the list of skipped files and a summary; returns the exit code.
