@@ -349,6 +349,28 @@ constexpr double kFlatRatio = 0.25;
 // vertices; a smaller one (a palm, a fist, a flat ear's tip) gets curve nodes.
 constexpr double kSheetRegionShare = 0.05;
 
+// The skeleton stands for the union of its curve nodes' balls swept along its curve edges, the
+// radius interpolated linearly along each edge. How far q lies outside the part swept along the
+// edge (a, b): its distance to the nearest point of the segment minus the radius there (< 0:
+// inside).
+float outside_swept_ball(const glm::vec3& q, const glm::vec3& a, float ra, const glm::vec3& b, float rb) {
+  const glm::vec3 ab = b - a;
+  const float len2 = glm::dot(ab, ab);
+  const float t = len2 > 0.0f ? std::clamp(glm::dot(q - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+  return glm::length(q - (a + t * ab)) - (ra + t * (rb - ra));
+}
+float outside_swept_ball(const glm::vec3& q, const Node& a, const Node& b) {
+  return outside_swept_ball(q, a.position, a.radius, b.position, b.radius);
+}
+
+// Distance from q to the segment ab.
+float distance_to_segment(const glm::vec3& q, const glm::vec3& a, const glm::vec3& b) {
+  const glm::vec3 ab = b - a;
+  const float len2 = glm::dot(ab, ab);
+  const float t = len2 > 0.0f ? std::clamp(glm::dot(q - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+  return glm::length(q - (a + t * ab));
+}
+
 // Eigenvalues of a symmetric positive semi-definite 3x3 matrix, largest first (trigonometric
 // solution).
 std::array<double, 3> symmetric_eigenvalues(const glm::dmat3& a) {
@@ -463,6 +485,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   };
   detail::CurveGraph graph = surgery(surface, local_radius, proxy, so);
   watch.lap("connectivity surgery");
+
 
   std::size_t curve_nodes = graph.positions.size();
   std::vector<std::uint32_t> owner(n);
@@ -1282,12 +1305,15 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   }
   // Terminal branches covered by the rest of the skeleton: a branch (a leaf and the chain of
   // degree-2 curve nodes up to the first node of degree >= 3) whose every node's ball lies in
-  // the union of the other curve nodes' balls describes no part of the solid that the rest of
-  // the skeleton does not; it is a bump of the surface or a spur beside a limb's own curve,
-  // not a limb. A ball counts as covered when its centre and 26 points on its sphere (the
-  // directions of a 3x3x3 grid) each lie in another node's ball. (Until 2026-11-29 only the
+  // what the rest of the skeleton stands for (the other curve nodes' balls swept along the
+  // curve edges between them, as the protrusion step below reads the skeleton) describes no
+  // part of the solid that the rest does not; it is a bump of the surface or a spur beside a
+  // limb's own curve, not a limb. A ball counts as covered when its centre and 26 points on its
+  // sphere (the directions of a 3x3x3 grid) each lie in that union. (At first only the
   // junction's ball counted; spurs beside a limb, whose balls the neighbouring nodes of the
-  // limb cover together but no single ball does, stayed.) Such branches are merged into their
+  // limb cover together but no single ball does, stayed. Then the edges were not swept: a
+  // ball centred on a limb's curve between two nodes lies in neither node's ball, and 14 spurs
+  // over CGAL's data set stayed for that.) Such branches are merged into their
   // junction, the one that reaches least out of the union first, while the junction keeps
   // degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
   if (options.prune_branches) {
@@ -1317,12 +1343,21 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         float excess = -std::numeric_limits<float>::infinity();
         for (std::size_t i = 0; i < path.size() && excess < 0.0f; ++i) {
           const Node& a = sk.nodes[path[i]];
-          // The other curve nodes whose balls meet this one's: only they can cover it.
+          // The other curve nodes and the curve edges between them whose balls meet this
+          // one's: only they can cover it.
+          auto other = [&](std::uint32_t m) {
+            return !on_path[m] && !dead[m] && !sk.nodes[m].sheet && !sk.nodes[m].vertices.empty();
+          };
           std::vector<std::uint32_t> near;
           for (std::uint32_t m = 0; m < sk.nodes.size(); ++m)
-            if (!on_path[m] && !dead[m] && !sk.nodes[m].sheet && !sk.nodes[m].vertices.empty() &&
-                glm::length(sk.nodes[m].position - a.position) < a.radius + sk.nodes[m].radius)
+            if (other(m) && glm::length(sk.nodes[m].position - a.position) < a.radius + sk.nodes[m].radius)
               near.push_back(m);
+          std::vector<std::array<std::uint32_t, 2>> near_edges;
+          for (const auto& e : edges)
+            if (other(e[0]) && other(e[1]) &&
+                distance_to_segment(a.position, sk.nodes[e[0]].position, sk.nodes[e[1]].position) <
+                    a.radius + std::max(sk.nodes[e[0]].radius, sk.nodes[e[1]].radius))
+              near_edges.push_back(e);
           for (int dx = -1; dx <= 1 && excess < 0.0f; ++dx)
             for (int dy = -1; dy <= 1 && excess < 0.0f; ++dy)
               for (int dz = -1; dz <= 1 && excess < 0.0f; ++dz) {
@@ -1331,6 +1366,8 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
                 float outside = std::numeric_limits<float>::infinity();
                 for (std::uint32_t m : near)
                   outside = std::min(outside, glm::length(q - sk.nodes[m].position) - sk.nodes[m].radius);
+                for (const auto& e : near_edges)
+                  outside = std::min(outside, outside_swept_ball(q, sk.nodes[e[0]], sk.nodes[e[1]]));
                 excess = std::max(excess, outside);
               }
         }
@@ -1598,12 +1635,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         if (!sk.nodes[e[0]].sheet && !sk.nodes[e[1]].sheet) curve_edges.push_back(e);
       }
       auto touches_edge = [&](const glm::vec3& p, float r, std::uint32_t a, std::uint32_t b) {
-        const Node& na = sk.nodes[a];
-        const Node& nb = sk.nodes[b];
-        const glm::vec3 ab = nb.position - na.position;
-        const float len2 = glm::dot(ab, ab);
-        const float t = len2 > 0.0f ? std::clamp(glm::dot(p - na.position, ab) / len2, 0.0f, 1.0f) : 0.0f;
-        return glm::length(p - (na.position + t * ab)) <= na.radius + t * (nb.radius - na.radius) + r;
+        return outside_swept_ball(p, sk.nodes[a], sk.nodes[b]) <= r;
       };
       // Does the ball (p, r) touch the skeleton's union? `hint`'s node and edges first.
       auto touches = [&](const glm::vec3& p, float r, std::uint32_t hint) {

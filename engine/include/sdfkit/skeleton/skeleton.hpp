@@ -155,9 +155,10 @@ struct SkeletonOptions {
   // leaf hanging off a degree-2 node, inside the tube of the edge that node continues on (a knee
   // hanging off the foot), is threaded into that edge, so the farther node becomes the leaf.
   bool extend_leaves = true;
-  // Drop a terminal curve branch whose nodes' balls (centre, radius) all lie inside the ball of
-  // the node it hangs from: it adds nothing to the solid the skeleton's balls describe (a bump
-  // on the surface, not a limb); its vertices go to that node.
+  // Drop a terminal curve branch whose nodes' balls (centre, radius) all lie inside the rest of
+  // the skeleton's balls swept along its curve edges: it adds nothing to the solid the
+  // skeleton describes (a bump on the surface, a spur beside a limb); its vertices go to the
+  // node it hangs from.
   bool prune_branches = true;
   // Cut each curve edge longer than two local radii into cross-sections one local radius apart,
   // with a node at the centre of each (the mean of its vertices' centre points), so the curve
