@@ -543,26 +543,73 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // Up to three rounds: what the first node leaves unseen (a long limb's tip) may get the next.
   std::vector<std::uint8_t> region_is_sheet(n, 0);
   // A new curve node at the mean of `part`'s centre points for the vertices of `part` that
-  // see it, joined to the nearest curve node it sees; false when under half of them see it or
-  // no node is seen from it.
+  // see it, joined to the nearest curve node it sees, or put on the curve edge whose swept ball
+  // it lies in (below); false when under half of them see it or no node is seen from it.
+  // The local radius of each curve node (SDF/2 over the vertices it stands for), for the union
+  // of balls swept along the curve edges that the skeleton stands for.
+  std::vector<float> node_radius(curve_nodes);
+  for (std::uint32_t c = 0; c < curve_nodes; ++c)
+    node_radius[c] = graph.members[c].empty() ? 0.0f : surface.radius(position[c], graph.members[c]);
   auto add_node = [&](const std::vector<std::uint32_t>& part) {
     const std::optional<Surface::RegionNode> node = surface.region_node(part);
     if (!node) return false;
     const glm::vec3 p = node->point;
     const std::vector<std::uint32_t>& seeing = node->seeing;
-    std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
-    for (std::uint32_t c = 0; c < curve_nodes; ++c) curve.push_back({c, position[c]});
-    const std::uint32_t attach = surface.nearest_seen_node(p, curve);
-    if (attach == UINT32_MAX) return false;
+    // A region whose centre points all lie in the union the curve already stands for is a
+    // part of a limb that the curve passes through (vertices in a crease of the limb that see
+    // none of its nodes), not a part the skeleton misses: its node goes on the curve edge whose
+    // swept ball holds it, which keeps the leaves the skeleton has, instead of hanging off the
+    // curve as a spur. A region with centre points outside (an ear whose base lies in the
+    // body's balls) is a part the skeleton misses and gets its branch.
+    const auto in_union = [&](const glm::vec3& q) {
+      for (const auto& [a, b] : graph.edges)
+        if (outside_swept_ball(q, position[a], node_radius[a], position[b], node_radius[b]) <= 0.0f) return true;
+      return false;
+    };
+    bool covered = true;
+    for (std::uint32_t k : part)
+      if (!in_union(surface.centre[k])) {
+        covered = false;
+        break;
+      }
+    std::size_t split = graph.edges.size();
+    float split_distance = std::numeric_limits<float>::max();
+    for (std::size_t i = 0; i < graph.edges.size() && covered; ++i) {
+      const auto [a, b] = graph.edges[i];
+      if (outside_swept_ball(p, position[a], node_radius[a], position[b], node_radius[b]) > 0.0f) continue;
+      const float d = distance_to_segment(p, position[a], position[b]);
+      if (d < split_distance && !surface.bvh.segment_blocked(position[a], p) && !surface.bvh.segment_blocked(p, position[b]))
+        split = i, split_distance = d;
+    }
+    std::uint32_t attach = UINT32_MAX;
+    if (split == graph.edges.size()) {
+      std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
+      for (std::uint32_t c = 0; c < curve_nodes; ++c) curve.push_back({c, position[c]});
+      attach = surface.nearest_seen_node(p, curve);
+      if (attach == UINT32_MAX) return false;
+    }
     const auto c = static_cast<std::uint32_t>(curve_nodes++);
     position.push_back(p);
+    node_radius.push_back(surface.radius(p, seeing));
     members.emplace_back();
     graph.members.emplace_back();
     graph.positions.push_back(p);
     graph_adjacency.emplace_back();
-    graph.edges.push_back({std::min(attach, c), std::max(attach, c)});
-    graph_adjacency[attach].push_back(c);
-    graph_adjacency[c].push_back(attach);
+    auto link = [&](std::uint32_t a, std::uint32_t b) {
+      graph.edges.push_back({std::min(a, b), std::max(a, b)});
+      graph_adjacency[a].push_back(b);
+      graph_adjacency[b].push_back(a);
+    };
+    if (split < graph.edges.size()) {
+      const auto [a, b] = graph.edges[split];
+      graph.edges.erase(graph.edges.begin() + static_cast<std::ptrdiff_t>(split));
+      std::erase(graph_adjacency[a], b);
+      std::erase(graph_adjacency[b], a);
+      link(a, c);
+      link(c, b);
+    } else {
+      link(attach, c);
+    }
     for (std::uint32_t k : seeing) choice[k] = c;
     return true;
   };

@@ -540,6 +540,55 @@ TEST(SkeletonRealMeshes, SpursCoveredByTheRestOfTheSkeletonArePruned) {
   expect_valid(mesh, after, "armadillo.off");
 }
 
+namespace {
+// Terminal curve branches whose nodes' centres all lie in what the rest of the skeleton stands
+// for (the other curve nodes' balls swept along the curve edges between them): the branch's
+// curve never leaves the rest, so its leaf marks no extremity of the solid (a spur).
+std::size_t spur_branches(const sk::Skeleton& s) {
+  std::size_t spurs = 0;
+  for (const auto& branch : terminal_branches(s)) {
+    const std::set<std::uint32_t> own(branch.begin(), branch.end() - 1);
+    const auto rest = [&](std::uint32_t m) { return !own.count(m) && !s.nodes[m].sheet; };
+    bool all_in = true;
+    for (std::size_t i = 0; i + 1 < branch.size() && all_in; ++i) {
+      const glm::vec3 q = s.nodes[branch[i]].position;
+      bool in = false;
+      for (std::uint32_t m = 0; m < s.nodes.size() && !in; ++m)
+        in = rest(m) && glm::length(q - s.nodes[m].position) <= s.nodes[m].radius;
+      for (std::size_t k = 0; k < s.edges.size() && !in; ++k) {
+        if (!rest(s.edges[k][0]) || !rest(s.edges[k][1])) continue;
+        const sk::Node& e0 = s.nodes[s.edges[k][0]];
+        const sk::Node& e1 = s.nodes[s.edges[k][1]];
+        const glm::vec3 ab = e1.position - e0.position;
+        const float len2 = glm::dot(ab, ab);
+        const float t = len2 > 0.0f ? std::clamp(glm::dot(q - e0.position, ab) / len2, 0.0f, 1.0f) : 0.0f;
+        in = glm::length(q - (e0.position + t * ab)) <= e0.radius + t * (e1.radius - e0.radius);
+      }
+      all_in = in;
+    }
+    spurs += all_in;
+  }
+  return spurs;
+}
+}  // namespace
+
+// Vertices in a crease of a limb may see none of the limb's nodes; the node that their region
+// gets lies inside the limb's tube, and hung off the nearest node it sees it was a spur: on the
+// armadillo and the man most leaves were spurs whose curve never leaves the rest of the
+// skeleton (with Embree, as here: 52 of 72 and 27 of 49). Such a node now goes on the curve
+// edge whose swept ball holds it (19 of 40 and 7 of 28). Most leaves must reach out of the rest
+// of the skeleton; the armadillo is near that line, the spurs left come from other steps.
+TEST(SkeletonRealMeshes, MostLeavesReachOutOfTheRestOfTheSkeleton) {
+  for (const char* name : {"armadillo.off", "man.off"}) {
+    const sk::Skeleton s = extract(load(name));
+    const auto d = degrees(s);
+    const auto leaves = static_cast<std::size_t>(std::count(d.begin(), d.end(), 1));
+    const std::size_t spurs = spur_branches(s);
+    std::printf("%s: %zu leaves, %zu of them on spurs inside the rest of the skeleton\n", name, leaves, spurs);
+    EXPECT_LT(2 * spurs, leaves) << name;
+  }
+}
+
 // A limb about as thick as the cell that the sheet test groups centre points in is a curve,
 // not a sheet: the armadillo's left forearm and hand (27 % of its nodes were sheet nodes, and
 // 8 % of its vertices could not see a curve node) are now curve nodes that every vertex sees.
