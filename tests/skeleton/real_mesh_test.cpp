@@ -576,7 +576,7 @@ std::size_t spur_branches(const sk::Skeleton& s) {
 // gets lies inside the limb's tube, and hung off the nearest node it sees it was a spur: on the
 // armadillo and the man most leaves were spurs whose curve never leaves the rest of the
 // skeleton (with Embree, as here: 52 of 72 and 27 of 49). Such a node now goes on the curve
-// edge whose swept ball holds it (19 of 40 and 7 of 28). Most leaves must reach out of the rest
+// edge whose swept ball holds it (20 of 43 and 7 of 30). Most leaves must reach out of the rest
 // of the skeleton; the armadillo is near that line, the spurs left come from other steps.
 TEST(SkeletonRealMeshes, MostLeavesReachOutOfTheRestOfTheSkeleton) {
   for (const char* name : {"armadillo.off", "man.off"}) {
