@@ -367,17 +367,19 @@ struct Summary {
     if (c.ok) {
       timed += c.seconds >= 0.0;
       faster += c.seconds >= 0.0 && e.seconds <= c.seconds;
-      match.push_back(e.leaf_match);
+      if (!c.graph.leaves.empty()) match.push_back(e.leaf_match);
       if (e.curve_distance >= 0.0) distance.push_back(e.curve_distance);
     }
   }
   void print(const char* what) const {
     std::printf("%s: %zu meshes, %zu failed; cycles = genus on %zu; all nodes inside on %zu; all "
                 "curve edges inside on %zu; median sheet share %.1f%%; median curve reliability "
-                "%.1f%%; median CGAL leaves matched %.0f%%; median curve distance to CGAL %.2f%% "
-                "of the diagonal; %s\n",
+                "%.1f%%; CGAL leaves matched >= 80%% on %zu of the %zu meshes whose CGAL skeleton "
+                "has leaves (median %.0f%%); median curve distance to CGAL %.2f%% of the diagonal; %s\n",
                 what, meshes, failed, cycles_ok, nodes_ok, edges_ok, 100.0 * median(sheet),
-                100.0 * median(reliability), 100.0 * median(match), median(distance),
+                100.0 * median(reliability),
+                static_cast<std::size_t>(std::count_if(match.begin(), match.end(), [](double m) { return m >= 0.8; })),
+                match.size(), 100.0 * median(match), median(distance),
                 !timed     ? "CGAL not timed (its skeletons read from a dump)"
                 : remeshed ? ("no slower than CGAL's MCF on its remeshed copy on " + std::to_string(faster) + " of " +
                               std::to_string(timed) + " (not CGAL on the same mesh)").c_str()
