@@ -421,6 +421,24 @@ std::vector<std::vector<std::uint32_t>> terminal_branches(const sk::Skeleton& s)
   return out;
 }
 
+// Whether q lies in what the skeleton stands for outside the nodes `own`: the other curve nodes'
+// balls swept along the curve edges between them (radius interpolated along each edge).
+bool in_rest(const sk::Skeleton& s, const std::set<std::uint32_t>& own, const glm::vec3& q) {
+  const auto rest = [&](std::uint32_t m) { return !own.count(m) && !s.nodes[m].sheet; };
+  for (std::uint32_t m = 0; m < s.nodes.size(); ++m)
+    if (rest(m) && glm::length(q - s.nodes[m].position) <= s.nodes[m].radius) return true;
+  for (const auto& e : s.edges) {
+    if (!rest(e[0]) || !rest(e[1])) continue;
+    const sk::Node& e0 = s.nodes[e[0]];
+    const sk::Node& e1 = s.nodes[e[1]];
+    const glm::vec3 ab = e1.position - e0.position;
+    const float len2 = glm::dot(ab, ab);
+    const float t = len2 > 0.0f ? std::clamp(glm::dot(q - e0.position, ab) / len2, 0.0f, 1.0f) : 0.0f;
+    if (glm::length(q - (e0.position + t * ab)) <= e0.radius + t * (e1.radius - e0.radius)) return true;
+  }
+  return false;
+}
+
 // Terminal curve branches whose every ball lies in what the rest of the skeleton stands for:
 // the other curve nodes' balls swept along the curve edges between them (radius interpolated
 // along each edge), tested at each ball's centre and 26 + 64 points on its sphere (the 3x3x3
@@ -444,21 +462,7 @@ std::size_t covered_branches(const sk::Skeleton& s) {
     for (std::size_t i = 0; i + 1 < branch.size() && all_in; ++i) {
       const sk::Node& a = s.nodes[branch[i]];
       for (const glm::vec3& d : directions) {
-        const glm::vec3 q = a.position + a.radius * d;
-        const auto rest = [&](std::uint32_t m) { return !own.count(m) && !s.nodes[m].sheet; };
-        bool in = false;
-        for (std::uint32_t m = 0; m < s.nodes.size() && !in; ++m)
-          in = rest(m) && glm::length(q - s.nodes[m].position) <= s.nodes[m].radius;
-        for (std::size_t k = 0; k < s.edges.size() && !in; ++k) {
-          const sk::Node& e0 = s.nodes[s.edges[k][0]];
-          const sk::Node& e1 = s.nodes[s.edges[k][1]];
-          if (!rest(s.edges[k][0]) || !rest(s.edges[k][1])) continue;
-          const glm::vec3 ab = e1.position - e0.position;
-          const float len2 = glm::dot(ab, ab);
-          const float t = len2 > 0.0f ? std::clamp(glm::dot(q - e0.position, ab) / len2, 0.0f, 1.0f) : 0.0f;
-          in = glm::length(q - (e0.position + t * ab)) <= e0.radius + t * (e1.radius - e0.radius);
-        }
-        if (!in) {
+        if (!in_rest(s, own, a.position + a.radius * d)) {
           all_in = false;
           break;
         }
@@ -548,24 +552,8 @@ std::size_t spur_branches(const sk::Skeleton& s) {
   std::size_t spurs = 0;
   for (const auto& branch : terminal_branches(s)) {
     const std::set<std::uint32_t> own(branch.begin(), branch.end() - 1);
-    const auto rest = [&](std::uint32_t m) { return !own.count(m) && !s.nodes[m].sheet; };
     bool all_in = true;
-    for (std::size_t i = 0; i + 1 < branch.size() && all_in; ++i) {
-      const glm::vec3 q = s.nodes[branch[i]].position;
-      bool in = false;
-      for (std::uint32_t m = 0; m < s.nodes.size() && !in; ++m)
-        in = rest(m) && glm::length(q - s.nodes[m].position) <= s.nodes[m].radius;
-      for (std::size_t k = 0; k < s.edges.size() && !in; ++k) {
-        if (!rest(s.edges[k][0]) || !rest(s.edges[k][1])) continue;
-        const sk::Node& e0 = s.nodes[s.edges[k][0]];
-        const sk::Node& e1 = s.nodes[s.edges[k][1]];
-        const glm::vec3 ab = e1.position - e0.position;
-        const float len2 = glm::dot(ab, ab);
-        const float t = len2 > 0.0f ? std::clamp(glm::dot(q - e0.position, ab) / len2, 0.0f, 1.0f) : 0.0f;
-        in = glm::length(q - (e0.position + t * ab)) <= e0.radius + t * (e1.radius - e0.radius);
-      }
-      all_in = in;
-    }
+    for (std::size_t i = 0; i + 1 < branch.size() && all_in; ++i) all_in = in_rest(s, own, s.nodes[branch[i]].position);
     spurs += all_in;
   }
   return spurs;
