@@ -164,8 +164,9 @@ int main(int argc, char** argv) {
     } else if (arg == "--cgal-remesh" && i + 1 < argc) {
       char* end = nullptr;
       eval.cgal_remesh = std::strtod(argv[++i], &end) / 100.0;
-      if (*end != '\0' || !(eval.cgal_remesh > 0.0 && eval.cgal_remesh < 1.0)) {
-        std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-remesh %s: expected a percentage of the diagonal in (0, 100)\n",
+      // Below 0.1 % of the diagonal the copy of a sphere would have over a million vertices.
+      if (*end != '\0' || !(eval.cgal_remesh >= 0.001 && eval.cgal_remesh < 1.0)) {
+        std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-remesh %s: expected a percentage of the diagonal in [0.1, 100)\n",
                      argv[i]);
         return 2;
       }
@@ -188,7 +189,6 @@ int main(int argc, char** argv) {
       paths.push_back(arg);
     }
   }
-  // A directory of CGAL skeletons that is not there would turn every mesh's row into an error.
   if (!eval.cgal_dir.empty() && eval.cgal_remesh > 0.0) {
     std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-remesh has no effect with --cgal-from (CGAL's skeletons are read, not computed)\n");
     return 2;
@@ -204,6 +204,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  // A directory of CGAL skeletons that is not there would turn every mesh's row into an error.
   if (!eval.cgal_dir.empty() && !std::filesystem::is_directory(eval.cgal_dir)) {
     std::fprintf(stderr, "sdfkit_skeleton_bench: --cgal-from %s: no such directory (write one with --dump)\n",
                  eval.cgal_dir.c_str());
