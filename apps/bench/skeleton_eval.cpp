@@ -73,7 +73,6 @@ struct CgalResult {
   double seconds = 0.0;
   int iterations = 0;
   int cycles = 0;
-  std::size_t remeshed_vertices = 0;  // vertices of the remeshed copy CGAL got (0: not remeshed)
   Graph graph;
 };
 
@@ -118,7 +117,6 @@ CgalResult run_cgal(const sdfkit::Mesh& mesh, double remesh) {
       pmp::isotropic_remeshing(faces(tm), std::min(remesh * diag, mean_edge), tm,
                                CGAL::parameters::number_of_iterations(3));
       tm.collect_garbage();
-      r.remeshed_vertices = tm.number_of_vertices();
     }
     const auto t0 = std::chrono::steady_clock::now();
     Mcf mcf(tm);

@@ -486,7 +486,6 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   detail::CurveGraph graph = surgery(surface, local_radius, proxy, so);
   watch.lap("connectivity surgery");
 
-
   std::size_t curve_nodes = graph.positions.size();
   std::vector<std::uint32_t> owner(n);
   for (std::uint32_t c = 0; c < curve_nodes; ++c)
@@ -542,14 +541,14 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   // that point (a non-convex cross-section: the C and S plates) or no node is seen from it.
   // Up to three rounds: what the first node leaves unseen (a long limb's tip) may get the next.
   std::vector<std::uint8_t> region_is_sheet(n, 0);
-  // A new curve node at the mean of `part`'s centre points for the vertices of `part` that
-  // see it, joined to the nearest curve node it sees, or put on the curve edge whose swept ball
-  // it lies in (below); false when under half of them see it or no node is seen from it.
   // The local radius of each curve node (SDF/2 over the vertices it stands for), for the union
   // of balls swept along the curve edges that the skeleton stands for.
   std::vector<float> node_radius(curve_nodes);
   for (std::uint32_t c = 0; c < curve_nodes; ++c)
     node_radius[c] = graph.members[c].empty() ? 0.0f : surface.radius(position[c], graph.members[c]);
+  // A new curve node at the mean of `part`'s centre points for the vertices of `part` that
+  // see it, joined to the nearest curve node it sees, or put on the curve edge whose swept ball
+  // it lies in (below); false when under half of them see it or no node is seen from it.
   auto add_node = [&](const std::vector<std::uint32_t>& part) {
     const std::optional<Surface::RegionNode> node = surface.region_node(part);
     if (!node) return false;
