@@ -577,6 +577,35 @@ private:
   std::map<std::string, std::size_t> skipped_;
 };
 
+// The GLB container's layout: every chunk (8-byte header and data) inside the length the header
+// declares, and that length inside the file. tinygltf checks the BIN chunk's data against the
+// length without its 8-byte header, so a BIN chunk could end up to 8 bytes past the file and its
+// buffer be copied from there. Returns the problem, or "" (a file too short for a header is left
+// to tinygltf, which says so).
+std::string glb_layout_problem(std::string_view data) {
+  if (data.size() < 12) return "";
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int b = 3; b >= 0; --b) v = (v << 8) | static_cast<unsigned char>(data[at + b]);
+    return v;
+  };
+  const std::uint64_t length = u32(8);
+  if (length > data.size())
+    return "the GLB header says " + std::to_string(length) + " bytes but the file has " +
+           std::to_string(data.size());
+  std::uint64_t at = 12;
+  for (int chunk = 0; at < length; ++chunk) {
+    if (at + 8 > length)
+      return "GLB chunk " + std::to_string(chunk) + "'s header reaches past the GLB's length";
+    const std::uint64_t size = u32(static_cast<std::size_t>(at));
+    if (at + 8 + size > length)
+      return "GLB chunk " + std::to_string(chunk) + " (" + std::to_string(size) +
+             " bytes) reaches past the GLB's length";
+    at += 8 + size;
+  }
+  return "";
+}
+
 }  // namespace
 
 RawMesh read_gltf(const std::string& path, std::string_view data, bool binary,
@@ -589,6 +618,10 @@ RawMesh read_gltf(const std::string& path, std::string_view data, bool binary,
   loader.SetPreserveImageChannels(true);
   if (data.empty()) fail(path, "invalid glTF: the file is empty");
   if (data.size() > UINT32_MAX) fail(path, "invalid glTF: larger than 4 GiB");
+  if (binary) {
+    const std::string problem = glb_layout_problem(data);
+    if (!problem.empty()) fail(path, "invalid glTF: " + problem);
+  }
   std::string err, warn;
   const bool ok =
       binary ? loader.LoadBinaryFromMemory(&source->model, &err, &warn,

@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace sdfkit {
 namespace {
@@ -162,6 +164,17 @@ TEST(BadInput, Gltf) {
   {
     const std::string glb = triangle_gltf().glb(kScene);
     expect_bad(dir, "truncated.glb", glb.substr(0, glb.size() - 10), "invalid glTF");
+    // The BIN chunk claiming 8 bytes more than the GLB holds: tinygltf alone lets its data run
+    // past the file (it forgets the chunk's 8-byte header).
+    std::string longer = glb;
+    const std::size_t bin_at = 20 + static_cast<unsigned char>(glb[12]) +
+                               256u * static_cast<unsigned char>(glb[13]);
+    std::uint32_t bin_size = 0;
+    std::memcpy(&bin_size, glb.data() + bin_at, 4);
+    bin_size += 8;
+    std::memcpy(longer.data() + bin_at, &bin_size, 4);
+    expect_bad(dir, "binpast.glb", longer, "GLB chunk 1 (" + std::to_string(bin_size) +
+                                               " bytes) reaches past the GLB's length");
   }
   expect_bad(dir, "lines.gltf", triangle_gltf(1).data_uri_gltf(kScene),
              "no triangle primitives (skipped 1 LINES primitives)");
