@@ -785,6 +785,29 @@ TEST_F(Diffuse, StepsCarryTheKernelAcrossACoarseMeshsCharts) {
   }
 }
 
+// A conformal map compresses as freely as it stretches: on CGAL's bones (26 small bones) a joint
+// chart's least squares conformal map packed part of its faces into a few texels, and at 2 mean
+// edges texture-space diffusion was 3.08 times further from heat diffusion than k-ring smoothing
+// (Pearson 0.996, RMS 0.0312 against k-ring's 0.0101). A face the map shrinks past max_stretch
+// (sigma2 < 1 / max_stretch, the bound the map already had on stretching) now leaves the band, or
+// the chart keeps its projection: 0.91 times k-ring's RMS (0.0092), as the issue asks (never
+// further from heat than k-ring at the same sigma).
+TEST_F(Diffuse, ConformalMapsDoNotCompressFacesPastMaxStretch) {
+  const Mesh m = io::load_asset(test::data_mesh("bones.off")).mesh;
+  const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
+  const std::vector<float> u = test::wave_field(m);
+  const float edge = mean_edge_length(m);
+  const float sigma = 2.0f * edge;
+  StmOptions so;
+  so.overlap = kBandSigmas * sigma;
+  const AtlasMapping a = build_stm(m, skel, so).mapping;
+  const HeatComparison c = compare_with_heat(*diffuser_, m, a, u, sigma, edge);
+  std::printf("bones, 2 edges: %u steps, pearson %.4f, RMS %.4f (k-ring %.4f, k = %d)\n", c.steps, c.texture.pearson,
+              c.texture.rms, c.kring.rms, c.rings);
+  EXPECT_GE(c.texture.pearson, 0.95);
+  EXPECT_LE(c.texture.rms, c.kring.rms);
+}
+
 // A real mesh through the real mapping: CGAL's camel, its skeleton extracted from the geometry
 // (no SDF backend) and build_stm's atlas, with the overlap band of kBandSigmas sigma that the
 // blur needs (StmOptions::overlap) and every vertex read back from every chart covering it,
@@ -909,6 +932,8 @@ TEST_F(Diffuse, StretchCompensatedBlurFollowsABoneOfVaryingRadius) {
 // The blend is a partition of unity: a constant field stays constant through the camel's blended
 // read-back (every chart's normalized read of a constant is that constant), and a mapping whose
 // samples are each vertex's own chart alone, at any weight, reads what the unblended mapping reads.
+// One blur step, so that the test holds one read-back (over the automatic steps, each step's
+// rounding is rasterized and blurred again: 1.4e-5 relative after them on this atlas).
 TEST_F(Diffuse, BlendedReadBackIsAPartitionOfUnity) {
   const Mesh m = io::load_asset(test::data_mesh("camel.off")).mesh;
   const skeleton::Skeleton skel = skeleton::extract(m, nullptr, {}, {});
@@ -916,15 +941,20 @@ TEST_F(Diffuse, BlendedReadBackIsAPartitionOfUnity) {
   StmOptions so;
   so.overlap = kBandSigmas * sigma;
   const AtlasMapping a = build_stm(m, skel, so).mapping;
+  const auto one_step = [&] {
+    DiffuseOptions o = sigma_of(sigma);
+    o.steps = 1;
+    return o;
+  };
   const std::vector<float> constant(m.vertex_count(), 2.5f);
-  for (float x : diffuser_->run(m, a, constant, sigma_of(sigma)).values) ASSERT_NEAR(x, 2.5f, 1e-5f);
+  for (float x : diffuser_->run(m, a, constant, one_step()).values) ASSERT_NEAR(x, 2.5f, 1e-5f);
   AtlasMapping own = a, plain = a;
   plain.samples.clear();
   own.samples.clear();
   for (std::uint32_t v = 0; v < m.vertex_count(); ++v)
     own.samples.push_back({v, a.vertex_chart[v], a.vertex_uv[v], 0.25f + 0.5f * static_cast<float>(v % 3)});
   const std::vector<float> u = test::wave_field(m);
-  const std::vector<float> x = diffuser_->run(m, own, u, sigma_of(sigma)).values, y = diffuser_->run(m, plain, u, sigma_of(sigma)).values;
+  const std::vector<float> x = diffuser_->run(m, own, u, one_step()).values, y = diffuser_->run(m, plain, u, one_step()).values;
   for (std::size_t v = 0; v < x.size(); ++v) ASSERT_NEAR(x[v], y[v], 1e-5f * std::abs(y[v]) + 1e-6f) << v;
 }
 

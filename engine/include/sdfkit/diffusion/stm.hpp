@@ -77,7 +77,8 @@ struct StmOptions {
   bool blend = true;
   // With an overlap band: each joint and sheet chart takes a least squares conformal map (LSCM)
   // over the faces it holds (its own and its band's) in place of its projection. Band faces the
-  // map turns over, squashes (σ1/σ2 > max_stretch) or stretches past max_stretch leave the band
+  // map turns over, squashes (σ1/σ2 > max_stretch), stretches past max_stretch or shrinks past
+  // it (σ2 < 1 / max_stretch) leave the band
   // (the map is solved again, up to 4 times); kept where the chart's own faces all pass and the
   // map does not fold over itself. False: the projections alone (orthographic, or stereographic
   // around the skeleton).
