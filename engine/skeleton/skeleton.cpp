@@ -349,26 +349,28 @@ constexpr double kFlatRatio = 0.25;
 // vertices; a smaller one (a palm, a fist, a flat ear's tip) gets curve nodes.
 constexpr double kSheetRegionShare = 0.05;
 
+// Where the point of the segment ab nearest q lies, as t in [0, 1] (a + t (b - a)).
+float segment_parameter(const glm::vec3& q, const glm::vec3& a, const glm::vec3& b) {
+  const glm::vec3 ab = b - a;
+  const float len2 = glm::dot(ab, ab);
+  return len2 > 0.0f ? std::clamp(glm::dot(q - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+}
+
+// Distance from q to the segment ab.
+float distance_to_segment(const glm::vec3& q, const glm::vec3& a, const glm::vec3& b) {
+  return glm::length(q - (a + segment_parameter(q, a, b) * (b - a)));
+}
+
 // The skeleton stands for the union of its curve nodes' balls swept along its curve edges, the
 // radius interpolated linearly along each edge. How far q lies outside the part swept along the
 // edge (a, b): its distance to the nearest point of the segment minus the radius there (< 0:
 // inside).
 float outside_swept_ball(const glm::vec3& q, const glm::vec3& a, float ra, const glm::vec3& b, float rb) {
-  const glm::vec3 ab = b - a;
-  const float len2 = glm::dot(ab, ab);
-  const float t = len2 > 0.0f ? std::clamp(glm::dot(q - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
-  return glm::length(q - (a + t * ab)) - (ra + t * (rb - ra));
+  const float t = segment_parameter(q, a, b);
+  return glm::length(q - (a + t * (b - a))) - (ra + t * (rb - ra));
 }
 float outside_swept_ball(const glm::vec3& q, const Node& a, const Node& b) {
   return outside_swept_ball(q, a.position, a.radius, b.position, b.radius);
-}
-
-// Distance from q to the segment ab.
-float distance_to_segment(const glm::vec3& q, const glm::vec3& a, const glm::vec3& b) {
-  const glm::vec3 ab = b - a;
-  const float len2 = glm::dot(ab, ab);
-  const float t = len2 > 0.0f ? std::clamp(glm::dot(q - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
-  return glm::length(q - (a + t * ab));
 }
 
 // Eigenvalues of a symmetric positive semi-definite 3x3 matrix, largest first (trigonometric
