@@ -302,6 +302,7 @@ Eval run_sdfkit(const sdfkit::Mesh& mesh, sdfkit::SdfBackend& backend, bool sdf_
     sk::SkeletonOptions so;  // library defaults; SDFKIT_EVAL_EXTEND_LEAVES=0 / SDFKIT_EVAL_PRUNE_BRANCHES=0 for the comparisons
     if (const char* v = std::getenv("SDFKIT_EVAL_EXTEND_LEAVES")) so.extend_leaves = std::atoi(v) != 0;
     if (const char* v = std::getenv("SDFKIT_EVAL_PRUNE_BRANCHES")) so.prune_branches = std::atoi(v) != 0;
+    if (const char* v = std::getenv("SDFKIT_EVAL_UNFOLD_BRANCHES")) so.unfold_branches = std::atoi(v) != 0;
     if (const char* v = std::getenv("SDFKIT_EVAL_SECTION_NODES")) so.section_nodes = std::atoi(v) != 0;
     if (const char* v = std::getenv("SDFKIT_EVAL_PROTRUSION_BRANCHES")) so.protrusion_branches = std::atoi(v) != 0;
     const sk::Skeleton s = sk::extract(mesh, &backend, co, so);

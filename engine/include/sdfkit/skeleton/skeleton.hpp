@@ -160,6 +160,11 @@ struct SkeletonOptions {
   // skeleton describes (a bump on the surface, a spur beside a limb); its vertices go to the
   // node it hangs from.
   bool prune_branches = true;
+  // Unfold a terminal curve branch that runs out along its limb and back (a leg contracted to
+  // a flat ribbon collapses to its two rims, joined at the hoof): the run of nodes from the leaf
+  // that lies beside the rest of the branch is threaded into it, so the leaf is where the
+  // branch turned.
+  bool unfold_branches = true;
   // Cut each curve edge longer than two local radii into cross-sections one local radius apart,
   // with a node at the centre of each (the mean of its vertices' centre points), so the curve
   // follows a bending limb instead of a chord between grouped nodes.
