@@ -398,6 +398,227 @@ std::set<std::array<std::uint32_t, 2>> renumbered(const std::set<std::array<std:
   return out;
 }
 
+// Terminal branches covered by the rest of the skeleton: a branch (a leaf and the chain of
+// degree-2 curve nodes up to the first node of degree >= 3) whose every node's ball lies in
+// what the rest of the skeleton stands for (the other curve nodes' balls swept along the
+// curve edges between them, as the protrusion step reads the skeleton) describes no
+// part of the solid that the rest does not; it is a bump of the surface or a spur beside a
+// limb's own curve, not a limb. A ball counts as covered when its centre and 26 points on its
+// sphere (the directions of a 3x3x3 grid) each lie in that union. (At first only the
+// junction's ball counted; spurs beside a limb, whose balls the neighbouring nodes of the
+// limb cover together but no single ball does, stayed. Then the edges were not swept: a
+// ball centred on a limb's curve between two nodes lies in neither node's ball, and 14 spurs
+// over CGAL's data set stayed for that.) Such branches are merged into their
+// junction, the one that reaches least out of the union first, while the junction keeps
+// degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
+void prune_covered_branches(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
+                            std::vector<std::uint32_t>& node_of_vertex) {
+  std::vector<std::uint8_t> dead(sk.nodes.size(), 0);
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+    for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+    struct Branch {
+      float excess;  // how far the branch's balls reach out of the other nodes' (< 0: inside)
+      std::uint32_t leaf, junction;
+      std::vector<std::uint32_t> path;
+    };
+    std::vector<std::uint8_t> on_path(sk.nodes.size(), 0);
+    std::vector<Branch> branches;
+    for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
+      if (dead[leaf] || adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet) continue;
+      std::vector<std::uint32_t> path{leaf};
+      std::uint32_t prev = leaf, cur = adjacency[leaf].front();
+      while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
+        path.push_back(cur);
+        const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
+        prev = cur, cur = next;
+      }
+      if (adjacency[cur].size() < 3 || sk.nodes[cur].sheet) continue;
+      for (std::uint32_t k : path) on_path[k] = 1;
+      float excess = -std::numeric_limits<float>::infinity();
+      for (std::size_t i = 0; i < path.size() && excess < 0.0f; ++i) {
+        const Node& a = sk.nodes[path[i]];
+        // The other curve nodes and the curve edges between them whose balls meet this
+        // one's: only they can cover it.
+        auto other = [&](std::uint32_t m) {
+          return !on_path[m] && !dead[m] && !sk.nodes[m].sheet && !sk.nodes[m].vertices.empty();
+        };
+        std::vector<std::uint32_t> near;
+        for (std::uint32_t m = 0; m < sk.nodes.size(); ++m)
+          if (other(m) && glm::length(sk.nodes[m].position - a.position) < a.radius + sk.nodes[m].radius)
+            near.push_back(m);
+        std::vector<std::array<std::uint32_t, 2>> near_edges;
+        for (const auto& e : edges)
+          if (other(e[0]) && other(e[1]) &&
+              distance_to_segment(a.position, sk.nodes[e[0]].position, sk.nodes[e[1]].position) <
+                  a.radius + std::max(sk.nodes[e[0]].radius, sk.nodes[e[1]].radius))
+            near_edges.push_back(e);
+        for (int dx = -1; dx <= 1 && excess < 0.0f; ++dx)
+          for (int dy = -1; dy <= 1 && excess < 0.0f; ++dy)
+            for (int dz = -1; dz <= 1 && excess < 0.0f; ++dz) {
+              const glm::vec3 d(static_cast<float>(dx), static_cast<float>(dy), static_cast<float>(dz));
+              const glm::vec3 q = d == glm::vec3(0.0f) ? a.position : a.position + a.radius * glm::normalize(d);
+              float outside = std::numeric_limits<float>::infinity();
+              for (std::uint32_t m : near)
+                outside = std::min(outside, glm::length(q - sk.nodes[m].position) - sk.nodes[m].radius);
+              for (const auto& e : near_edges)
+                outside = std::min(outside, outside_swept_ball(q, sk.nodes[e[0]], sk.nodes[e[1]]));
+              excess = std::max(excess, outside);
+            }
+      }
+      for (std::uint32_t k : path) on_path[k] = 0;
+      if (excess < 0.0f) branches.push_back({excess, leaf, cur, std::move(path)});
+    }
+    std::sort(branches.begin(), branches.end(), [](const Branch& a, const Branch& b) {
+      return a.excess != b.excess ? a.excess < b.excess : a.leaf < b.leaf;
+    });
+    std::vector<std::size_t> degree(sk.nodes.size());
+    for (std::uint32_t k = 0; k < sk.nodes.size(); ++k) degree[k] = adjacency[k].size();
+    for (const Branch& b : branches) {
+      if (degree[b.junction] < 3 || dead[b.leaf]) continue;
+      std::uint32_t prev = b.junction;
+      for (auto it = b.path.rbegin(); it != b.path.rend(); ++it) {
+        edges.erase({std::min(prev, *it), std::max(prev, *it)});
+        prev = *it;
+      }
+      --degree[b.junction];
+      Node& j = sk.nodes[b.junction];
+      for (std::uint32_t k : b.path) {
+        for (std::uint32_t v : sk.nodes[k].vertices) node_of_vertex[v] = b.junction;
+        j.vertices.insert(j.vertices.end(), sk.nodes[k].vertices.begin(), sk.nodes[k].vertices.end());
+        sk.nodes[k].vertices.clear();
+        dead[k] = 1;
+      }
+      std::sort(j.vertices.begin(), j.vertices.end());
+      changed = true;
+    }
+  }
+  // Remove the merged nodes and renumber.
+  if (std::find(dead.begin(), dead.end(), 1) != dead.end())
+    edges = renumbered(edges, remove_nodes(sk, dead, node_of_vertex));
+}
+
+// Terminal branches that fold. A leg that contracted to a flat ribbon collapses to its two
+// rims, joined at the hoof; placed at their vertices' centre points the rims fall onto one
+// line, and with the loop cut at the top the leg's chain runs down to the hoof and back up,
+// its leaf at mid-leg (CGAL's cow and bull). A branch (a leaf and its chain of degree-2 curve
+// nodes up to the first node of another degree) folds where a run of its nodes from the leaf
+// lies beside the rest of the branch. A node x lies beside an edge of the rest when it
+// projects strictly between the edge's ends, its centre is inside the balls swept along the
+// edge, and the edge passes through x's own ball: both ways, since a thin foot bent back along
+// a thick leg lies in the leg's balls but the leg's axis is not in the foot's (triceratops).
+// A node that coincides with an inner node of the rest (each inside the other's ball, that
+// node the rest's nearest) lies beside it too. The longest such run is threaded into the
+// rest, each node into the edge it lies deepest in (outside_swept_ball over the radius there)
+// in the order they project onto it, so the node where the branch turned becomes the leaf.
+// Along an unfolded chain a node lies past the end of the next edge, never strictly beside
+// it (a tube's axis cannot bend tighter than its radius), so a limb's own tip stays: the
+// rest's first node has no edge beyond it. Nodes and edges keep their counts, so the cycles
+// do. The new chain must be shorter than the branch was (so no two nodes trade places back
+// and forth) and stay inside, else the branch stays. Repeated while a branch changes (its new
+// leaf can start another run), each branch once per round. This runs after the cross-section
+// nodes: before them a limb's curve is a chord between grouped nodes, and the returning rim
+// lies off it near the hoof (the bull's folded leg then stayed), while earlier leaves moved
+// bunny00's ear branch 0.047 -> 0.086 of the diagonal from its tip.
+void unfold_branches(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges, const Surface& surface) {
+  std::size_t unfolded = 0;
+  for (std::size_t round = 0; round < sk.nodes.size(); ++round) {
+    std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+    for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+    std::vector<std::uint8_t> touched(sk.nodes.size(), 0);
+    bool changed = false;
+    for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
+      if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || touched[leaf]) continue;
+      // full: the leaf, its chain, and the node the chain ends at.
+      std::vector<std::uint32_t> full{leaf};
+      std::uint32_t prev = leaf, cur = adjacency[leaf].front();
+      while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
+        full.push_back(cur);
+        const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
+        prev = cur, cur = next;
+      }
+      full.push_back(cur);
+      if (sk.nodes[cur].sheet || touched[cur]) continue;
+      // Where node x lies deepest beside an edge of full[from..]: (edge's first index, t,
+      // depth), or index SIZE_MAX when beside none.
+      struct Spot {
+        std::size_t edge = SIZE_MAX;
+        float t = 0.0f, depth = 0.0f;
+      };
+      auto beside = [&](std::uint32_t x, std::size_t from) {
+        Spot best;
+        const glm::vec3 p = sk.nodes[x].position;
+        for (std::size_t i = from; i + 1 < full.size(); ++i) {
+          const Node& a = sk.nodes[full[i]];
+          const Node& b = sk.nodes[full[i + 1]];
+          const float t = segment_parameter(p, a.position, b.position);
+          if (t <= 0.0f || t >= 1.0f) continue;
+          // Both ways: x's centre inside the balls swept along the edge, and the edge through
+          // x's own ball (a thin foot bent back along a thick leg lies in the leg's balls, but
+          // the leg's axis is not in the foot's).
+          const float depth = std::max(outside_swept_ball(p, a, b) / (a.radius + t * (b.radius - a.radius)),
+                                       distance_to_segment(p, a.position, b.position) / sk.nodes[x].radius - 1.0f);
+          if (depth < 0.0f && (best.edge == SIZE_MAX || depth < best.depth)) best = {i, t, depth};
+        }
+        // Or x coincides with an inner node y of the rest, the rest's node nearest to it
+        // (each inside the other's ball), where it projects onto neither of y's edges
+        // strictly: x goes next to y. (The rest's first node has no edge beyond it: a leaf
+        // past its neighbour, a limb's tip, is never beside.)
+        if (best.edge == SIZE_MAX) {
+          std::size_t j = from;
+          for (std::size_t i = from; i < full.size(); ++i)
+            if (glm::length(sk.nodes[full[i]].position - p) < glm::length(sk.nodes[full[j]].position - p)) j = i;
+          const float d = glm::length(sk.nodes[full[j]].position - p);
+          const float depth = std::max(d / sk.nodes[full[j]].radius, d / sk.nodes[x].radius) - 1.0f;
+          if (j > from && j + 1 < full.size() && depth < 0.0f) best = {j - 1, 1.0f, depth};
+        }
+        return best;
+      };
+      // The longest run full[0..m) whose every node lies beside an edge of full[m..].
+      std::size_t m = 0;
+      while (m + 2 < full.size()) {
+        bool all = true;
+        for (std::size_t i = 0; i <= m && all; ++i) all = beside(full[i], m + 1).edge != SIZE_MAX;
+        if (!all) break;
+        ++m;
+      }
+      if (m == 0) continue;
+      std::vector<std::vector<std::pair<float, std::uint32_t>>> into(full.size());
+      for (std::size_t i = 0; i < m; ++i) {
+        const Spot s = beside(full[i], m);
+        into[s.edge].push_back({s.t, full[i]});
+      }
+      std::vector<std::uint32_t> chain;
+      for (std::size_t i = m; i < full.size(); ++i) {
+        chain.push_back(full[i]);
+        std::sort(into[i].begin(), into[i].end());
+        for (const auto& [t, x] : into[i]) chain.push_back(x);
+      }
+      // Shorter than the branch was (so no two nodes trade places back and forth), and inside.
+      auto length = [&](const std::vector<std::uint32_t>& path) {
+        float sum = 0.0f;
+        for (std::size_t i = 0; i + 1 < path.size(); ++i)
+          sum += glm::length(sk.nodes[path[i]].position - sk.nodes[path[i + 1]].position);
+        return sum;
+      };
+      if (!(length(chain) < length(full))) continue;
+      bool inside = true;
+      for (std::size_t i = 0; i + 1 < chain.size() && inside; ++i)
+        inside = !surface.bvh.segment_blocked(sk.nodes[chain[i]].position, sk.nodes[chain[i + 1]].position);
+      if (!inside) continue;
+      for (std::size_t i = 0; i + 1 < full.size(); ++i)
+        edges.erase({std::min(full[i], full[i + 1]), std::max(full[i], full[i + 1])});
+      for (std::size_t i = 0; i + 1 < chain.size(); ++i) edges.insert({std::min(chain[i], chain[i + 1]), std::max(chain[i], chain[i + 1])});
+      for (std::uint32_t x : full) touched[x] = 1;
+      unfolded += m;
+      changed = true;
+    }
+    if (!changed) break;
+  }
+  log_debug("skeleton: " + std::to_string(unfolded) + " nodes of folded branches threaded back into their limb");
+}
+
 // Eigenvalues of a symmetric positive semi-definite 3x3 matrix, largest first (trigonometric
 // solution).
 std::array<double, 3> symmetric_eigenvalues(const glm::dmat3& a) {
@@ -1376,105 +1597,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
     }
   }
-  // Terminal branches covered by the rest of the skeleton: a branch (a leaf and the chain of
-  // degree-2 curve nodes up to the first node of degree >= 3) whose every node's ball lies in
-  // what the rest of the skeleton stands for (the other curve nodes' balls swept along the
-  // curve edges between them, as the protrusion step below reads the skeleton) describes no
-  // part of the solid that the rest does not; it is a bump of the surface or a spur beside a
-  // limb's own curve, not a limb. A ball counts as covered when its centre and 26 points on its
-  // sphere (the directions of a 3x3x3 grid) each lie in that union. (At first only the
-  // junction's ball counted; spurs beside a limb, whose balls the neighbouring nodes of the
-  // limb cover together but no single ball does, stayed. Then the edges were not swept: a
-  // ball centred on a limb's curve between two nodes lies in neither node's ball, and 14 spurs
-  // over CGAL's data set stayed for that.) Such branches are merged into their
-  // junction, the one that reaches least out of the union first, while the junction keeps
-  // degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
-  if (options.prune_branches) {
-    std::vector<std::uint8_t> dead(sk.nodes.size(), 0);
-    for (bool changed = true; changed;) {
-      changed = false;
-      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
-      for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
-      struct Branch {
-        float excess;  // how far the branch's balls reach out of the other nodes' (< 0: inside)
-        std::uint32_t leaf, junction;
-        std::vector<std::uint32_t> path;
-      };
-      std::vector<std::uint8_t> on_path(sk.nodes.size(), 0);
-      std::vector<Branch> branches;
-      for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
-        if (dead[leaf] || adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet) continue;
-        std::vector<std::uint32_t> path{leaf};
-        std::uint32_t prev = leaf, cur = adjacency[leaf].front();
-        while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
-          path.push_back(cur);
-          const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
-          prev = cur, cur = next;
-        }
-        if (adjacency[cur].size() < 3 || sk.nodes[cur].sheet) continue;
-        for (std::uint32_t k : path) on_path[k] = 1;
-        float excess = -std::numeric_limits<float>::infinity();
-        for (std::size_t i = 0; i < path.size() && excess < 0.0f; ++i) {
-          const Node& a = sk.nodes[path[i]];
-          // The other curve nodes and the curve edges between them whose balls meet this
-          // one's: only they can cover it.
-          auto other = [&](std::uint32_t m) {
-            return !on_path[m] && !dead[m] && !sk.nodes[m].sheet && !sk.nodes[m].vertices.empty();
-          };
-          std::vector<std::uint32_t> near;
-          for (std::uint32_t m = 0; m < sk.nodes.size(); ++m)
-            if (other(m) && glm::length(sk.nodes[m].position - a.position) < a.radius + sk.nodes[m].radius)
-              near.push_back(m);
-          std::vector<std::array<std::uint32_t, 2>> near_edges;
-          for (const auto& e : edges)
-            if (other(e[0]) && other(e[1]) &&
-                distance_to_segment(a.position, sk.nodes[e[0]].position, sk.nodes[e[1]].position) <
-                    a.radius + std::max(sk.nodes[e[0]].radius, sk.nodes[e[1]].radius))
-              near_edges.push_back(e);
-          for (int dx = -1; dx <= 1 && excess < 0.0f; ++dx)
-            for (int dy = -1; dy <= 1 && excess < 0.0f; ++dy)
-              for (int dz = -1; dz <= 1 && excess < 0.0f; ++dz) {
-                const glm::vec3 d(static_cast<float>(dx), static_cast<float>(dy), static_cast<float>(dz));
-                const glm::vec3 q = d == glm::vec3(0.0f) ? a.position : a.position + a.radius * glm::normalize(d);
-                float outside = std::numeric_limits<float>::infinity();
-                for (std::uint32_t m : near)
-                  outside = std::min(outside, glm::length(q - sk.nodes[m].position) - sk.nodes[m].radius);
-                for (const auto& e : near_edges)
-                  outside = std::min(outside, outside_swept_ball(q, sk.nodes[e[0]], sk.nodes[e[1]]));
-                excess = std::max(excess, outside);
-              }
-        }
-        for (std::uint32_t k : path) on_path[k] = 0;
-        if (excess < 0.0f) branches.push_back({excess, leaf, cur, std::move(path)});
-      }
-      std::sort(branches.begin(), branches.end(), [](const Branch& a, const Branch& b) {
-        return a.excess != b.excess ? a.excess < b.excess : a.leaf < b.leaf;
-      });
-      std::vector<std::size_t> degree(sk.nodes.size());
-      for (std::uint32_t k = 0; k < sk.nodes.size(); ++k) degree[k] = adjacency[k].size();
-      for (const Branch& b : branches) {
-        if (degree[b.junction] < 3 || dead[b.leaf]) continue;
-        std::uint32_t prev = b.junction;
-        for (auto it = b.path.rbegin(); it != b.path.rend(); ++it) {
-          edges.erase({std::min(prev, *it), std::max(prev, *it)});
-          prev = *it;
-        }
-        --degree[b.junction];
-        Node& j = sk.nodes[b.junction];
-        for (std::uint32_t k : b.path) {
-          for (std::uint32_t v : sk.nodes[k].vertices) node_of_vertex[v] = b.junction;
-          j.vertices.insert(j.vertices.end(), sk.nodes[k].vertices.begin(), sk.nodes[k].vertices.end());
-          sk.nodes[k].vertices.clear();
-          dead[k] = 1;
-        }
-        std::sort(j.vertices.begin(), j.vertices.end());
-        changed = true;
-      }
-    }
-    // Remove the merged nodes and renumber.
-    if (std::find(dead.begin(), dead.end(), 1) != dead.end())
-      edges = renumbered(edges, remove_nodes(sk, dead, node_of_vertex));
-  }
+  if (options.prune_branches) prune_covered_branches(sk, edges, node_of_vertex);
   // The tip node of a curve leaf (see below); nothing when `leaf` is not a curve leaf of
   // `adjacency` with at least two vertices.
   auto extend_tip = [&](std::uint32_t leaf, const std::vector<std::vector<std::uint32_t>>& adjacency) {
@@ -1644,125 +1767,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     }
   };
   if (options.section_nodes) add_sections(std::vector<std::array<std::uint32_t, 2>>(edges.begin(), edges.end()));
-  // Terminal branches that fold. A leg that contracted to a flat ribbon collapses to its two
-  // rims, joined at the hoof; placed at their vertices' centre points the rims fall onto one
-  // line, and with the loop cut at the top the leg's chain runs down to the hoof and back up,
-  // its leaf at mid-leg (CGAL's cow and bull). A branch (a leaf and its chain of degree-2 curve
-  // nodes up to the first node of another degree) folds where a run of its nodes from the leaf
-  // lies beside the rest of the branch. A node x lies beside an edge of the rest when it
-  // projects strictly between the edge's ends, its centre is inside the balls swept along the
-  // edge, and the edge passes through x's own ball: both ways, since a thin foot bent back along
-  // a thick leg lies in the leg's balls but the leg's axis is not in the foot's (triceratops).
-  // A node that coincides with an inner node of the rest (each inside the other's ball, that
-  // node the rest's nearest) lies beside it too. The longest such run is threaded into the
-  // rest, each node into the edge it lies deepest in (outside_swept_ball over the radius there)
-  // in the order they project onto it, so the node where the branch turned becomes the leaf.
-  // Along an unfolded chain a node lies past the end of the next edge, never strictly beside
-  // it (a tube's axis cannot bend tighter than its radius), so a limb's own tip stays: the
-  // rest's first node has no edge beyond it. Nodes and edges keep their counts, so the cycles
-  // do. The new chain must be shorter than the branch was (so no two nodes trade places back
-  // and forth) and stay inside, else the branch stays. Repeated while a branch changes (its new
-  // leaf can start another run), each branch once per round. This runs after the cross-section
-  // nodes: before them a limb's curve is a chord between grouped nodes, and the returning rim
-  // lies off it near the hoof (the bull's folded leg then stayed), while earlier leaves moved
-  // bunny00's ear branch 0.047 -> 0.086 of the diagonal from its tip.
-  if (options.unfold_branches) {
-    std::size_t unfolded = 0;
-    for (std::size_t round = 0; round < sk.nodes.size(); ++round) {
-      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
-      for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
-      std::vector<std::uint8_t> touched(sk.nodes.size(), 0);
-      bool changed = false;
-      for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
-        if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || touched[leaf]) continue;
-        // full: the leaf, its chain, and the node the chain ends at.
-        std::vector<std::uint32_t> full{leaf};
-        std::uint32_t prev = leaf, cur = adjacency[leaf].front();
-        while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
-          full.push_back(cur);
-          const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
-          prev = cur, cur = next;
-        }
-        full.push_back(cur);
-        if (sk.nodes[cur].sheet || touched[cur]) continue;
-        // Where node x lies deepest beside an edge of full[from..]: (edge's first index, t,
-        // depth), or index SIZE_MAX when beside none.
-        struct Spot {
-          std::size_t edge = SIZE_MAX;
-          float t = 0.0f, depth = 0.0f;
-        };
-        auto beside = [&](std::uint32_t x, std::size_t from) {
-          Spot best;
-          const glm::vec3 p = sk.nodes[x].position;
-          for (std::size_t i = from; i + 1 < full.size(); ++i) {
-            const Node& a = sk.nodes[full[i]];
-            const Node& b = sk.nodes[full[i + 1]];
-            const float t = segment_parameter(p, a.position, b.position);
-            if (t <= 0.0f || t >= 1.0f) continue;
-            // Both ways: x's centre inside the balls swept along the edge, and the edge through
-            // x's own ball (a thin foot bent back along a thick leg lies in the leg's balls, but
-            // the leg's axis is not in the foot's).
-            const float depth = std::max(outside_swept_ball(p, a, b) / (a.radius + t * (b.radius - a.radius)),
-                                         distance_to_segment(p, a.position, b.position) / sk.nodes[x].radius - 1.0f);
-            if (depth < 0.0f && (best.edge == SIZE_MAX || depth < best.depth)) best = {i, t, depth};
-          }
-          // Or x coincides with an inner node y of the rest, the rest's node nearest to it
-          // (each inside the other's ball), where it projects onto neither of y's edges
-          // strictly: x goes next to y. (The rest's first node has no edge beyond it: a leaf
-          // past its neighbour, a limb's tip, is never beside.)
-          if (best.edge == SIZE_MAX) {
-            std::size_t j = from;
-            for (std::size_t i = from; i < full.size(); ++i)
-              if (glm::length(sk.nodes[full[i]].position - p) < glm::length(sk.nodes[full[j]].position - p)) j = i;
-            const float d = glm::length(sk.nodes[full[j]].position - p);
-            const float depth = std::max(d / sk.nodes[full[j]].radius, d / sk.nodes[x].radius) - 1.0f;
-            if (j > from && j + 1 < full.size() && depth < 0.0f) best = {j - 1, 1.0f, depth};
-          }
-          return best;
-        };
-        // The longest run full[0..m) whose every node lies beside an edge of full[m..].
-        std::size_t m = 0;
-        while (m + 2 < full.size()) {
-          bool all = true;
-          for (std::size_t i = 0; i <= m && all; ++i) all = beside(full[i], m + 1).edge != SIZE_MAX;
-          if (!all) break;
-          ++m;
-        }
-        if (m == 0) continue;
-        std::vector<std::vector<std::pair<float, std::uint32_t>>> into(full.size());
-        for (std::size_t i = 0; i < m; ++i) {
-          const Spot s = beside(full[i], m);
-          into[s.edge].push_back({s.t, full[i]});
-        }
-        std::vector<std::uint32_t> chain;
-        for (std::size_t i = m; i < full.size(); ++i) {
-          chain.push_back(full[i]);
-          std::sort(into[i].begin(), into[i].end());
-          for (const auto& [t, x] : into[i]) chain.push_back(x);
-        }
-        // Shorter than the branch was (so no two nodes trade places back and forth), and inside.
-        auto length = [&](const std::vector<std::uint32_t>& path) {
-          float sum = 0.0f;
-          for (std::size_t i = 0; i + 1 < path.size(); ++i)
-            sum += glm::length(sk.nodes[path[i]].position - sk.nodes[path[i + 1]].position);
-          return sum;
-        };
-        if (!(length(chain) < length(full))) continue;
-        bool inside = true;
-        for (std::size_t i = 0; i + 1 < chain.size() && inside; ++i)
-          inside = !surface.bvh.segment_blocked(sk.nodes[chain[i]].position, sk.nodes[chain[i + 1]].position);
-        if (!inside) continue;
-        for (std::size_t i = 0; i + 1 < full.size(); ++i)
-          edges.erase({std::min(full[i], full[i + 1]), std::max(full[i], full[i + 1])});
-        for (std::size_t i = 0; i + 1 < chain.size(); ++i) add_edge(chain[i], chain[i + 1]);
-        for (std::uint32_t x : full) touched[x] = 1;
-        unfolded += m;
-        changed = true;
-      }
-      if (!changed) break;
-    }
-    log_debug("skeleton: " + std::to_string(unfolded) + " nodes of folded branches threaded back into their limb");
-  }
+  if (options.unfold_branches) unfold_branches(sk, edges, surface);
   // Protrusions that the contraction merged whole (s11branch): a thin part (an ear, a foot, a
   // tusk) that contracted into a node of the body and whose vertices see that node, so the
   // regions above (vertices that see no curve node) never gave it a branch. The skeleton stands
