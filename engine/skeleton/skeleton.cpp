@@ -398,6 +398,450 @@ std::set<std::array<std::uint32_t, 2>> renumbered(const std::set<std::array<std:
   return out;
 }
 
+// Edges whose segment leaves the solid (embedding refinement moved their ends apart around a
+// concavity, or a sheet link crosses a fold) are replaced by a detour through the node c that
+// minimizes |ac| + |cb| with both segments inside (of the 256 best); without one, where
+// dropping the edge splits the skeleton, the two parts are joined again by the shortest
+// segment between them that stays inside (of the 256 shortest pairs). An edge that neither
+// finds is kept (a connected skeleton with its cycles comes first) and returned, so that the
+// cycle pruning (prune_cycles) drops it before any edge inside.
+std::set<std::array<std::uint32_t, 2>> route_edges_inside(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
+                                                          std::vector<std::uint32_t>& node_of_vertex,
+                                                          const Surface& surface) {
+  const Mesh& original = surface.original;
+  const std::size_t n = original.positions.size();
+  std::set<std::array<std::uint32_t, 2>> through_air;
+  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
+    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
+  };
+  std::vector<std::array<std::uint32_t, 2>> blocked;
+  for (const auto& e : edges)
+    if (surface.bvh.segment_blocked(sk.nodes[e[0]].position, sk.nodes[e[1]].position)) blocked.push_back(e);
+  auto inside_segment = [&](std::uint32_t a, std::uint32_t b) {
+    return !surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position);
+  };
+  if (!blocked.empty()) {
+    // Genus of the mesh component of each vertex (Euler characteristic per component).
+    std::vector<int> vertex_genus(n, 0);
+    {
+      UnionFind comp(n);
+      const std::map<std::uint32_t, int> genus = detail::component_genus(original, comp);
+      for (std::uint32_t k = 0; k < n; ++k) {
+        const auto it = genus.find(comp.find(k));
+        vertex_genus[k] = it == genus.end() ? 0 : it->second;
+      }
+    }
+    auto in_handle_body = [&](std::uint32_t node) {
+      return !sk.nodes[node].vertices.empty() && vertex_genus[sk.nodes[node].vertices.front()] > 0;
+    };
+    for (const auto& e : blocked) edges.erase(e);
+    std::vector<std::array<std::uint32_t, 2>> unresolved;
+    for (const auto& e : blocked) {
+      const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+      std::vector<std::pair<float, std::uint32_t>> via;
+      for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
+        if (c != e[0] && c != e[1])
+          via.push_back({glm::length(sk.nodes[c].position - pa) + glm::length(sk.nodes[c].position - pb), c});
+      const std::size_t tried = std::min<std::size_t>(via.size(), 256);
+      std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
+      bool detoured = false;
+      // In a component of genus > 0, a detour along two edges the skeleton already has would
+      // drop the edge's cycle (a coarse handle's ring of three nodes: P, 3torus); those wait
+      // for a detour through a new node below.
+      const bool keep_cycle = in_handle_body(e[0]);
+      for (std::size_t i = 0; i < tried && !detoured; ++i)
+        if (!(keep_cycle && edges.count({std::min(e[0], via[i].second), std::max(e[0], via[i].second)}) &&
+              edges.count({std::min(e[1], via[i].second), std::max(e[1], via[i].second)})) &&
+            inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
+          add_edge(e[0], via[i].second);
+          add_edge(via[i].second, e[1]);
+          detoured = true;
+        }
+      if (!detoured) unresolved.push_back(e);
+    }
+    log_debug("skeleton: " + std::to_string(blocked.size()) + " edges leave the solid, " +
+              std::to_string(blocked.size() - unresolved.size()) + " detoured");
+    // Then a detour through a new node at the centre point of one of the two nodes' vertices
+    // (the vertex moves to the new node; its old node keeps at least one vertex).
+    std::vector<std::array<std::uint32_t, 2>> still;
+    for (const auto& e : unresolved) {
+      const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+      std::vector<std::pair<float, std::pair<std::uint32_t, std::uint32_t>>> via;  // (vertex, node)
+      for (std::uint32_t end : e)
+        if (!sk.nodes[end].sheet && sk.nodes[end].vertices.size() > 1)
+          for (std::uint32_t k : sk.nodes[end].vertices)
+            via.push_back({glm::length(surface.centre[k] - pa) + glm::length(surface.centre[k] - pb), {k, end}});
+      const std::size_t tried = std::min<std::size_t>(via.size(), 256);
+      std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
+      bool detoured = false;
+      for (std::size_t i = 0; i < tried && !detoured; ++i) {
+        const auto [k, end] = via[i].second;
+        const glm::vec3 c = surface.centre[k];
+        if (sk.nodes[end].vertices.size() < 2 || !surface.bvh.inside(c) ||
+            surface.bvh.segment_blocked(pa, c) || surface.bvh.segment_blocked(c, pb))
+          continue;
+        std::erase(sk.nodes[end].vertices, k);
+        Node node;
+        node.position = c;
+        node.vertices = {k};
+        node.radius = surface.radius(c, node.vertices);
+        const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+        sk.nodes.push_back(std::move(node));
+        node_of_vertex[k] = id;
+        add_edge(e[0], id);
+        add_edge(id, e[1]);
+        detoured = true;
+      }
+      if (!detoured) still.push_back(e);
+    }
+    // Then the shortest path from one end to the other through nodes whose surface regions
+    // touch (a mesh edge joins their vertices), every step inside the solid: the skeleton
+    // follows the surface around the concavity the edge cut across.
+    std::vector<std::array<std::uint32_t, 2>> unrouted;
+    if (!still.empty()) {
+      std::vector<std::vector<std::uint32_t>> touching(sk.nodes.size());
+      for (const Triangle& t : original.triangles)
+        for (int i = 0; i < 3; ++i) {
+          const std::uint32_t a = node_of_vertex[t[i]], b = node_of_vertex[t[(i + 1) % 3]];
+          if (a != b && a != UINT32_MAX && b != UINT32_MAX) touching[a].push_back(b);
+        }
+      for (auto& list : touching) {
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end()), list.end());
+      }
+      std::map<std::array<std::uint32_t, 2>, bool> inside_cache;
+      auto step_inside = [&](std::uint32_t a, std::uint32_t b) {
+        const std::array<std::uint32_t, 2> key{std::min(a, b), std::max(a, b)};
+        const auto it = inside_cache.find(key);
+        if (it != inside_cache.end()) return it->second;
+        return inside_cache[key] = inside_segment(a, b);
+      };
+      for (const auto& e : still) {
+        std::vector<float> dist(sk.nodes.size(), std::numeric_limits<float>::infinity());
+        std::vector<std::uint32_t> from(sk.nodes.size(), UINT32_MAX);
+        using Item = std::pair<float, std::uint32_t>;
+        std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+        dist[e[0]] = 0.0f;
+        queue.push({0.0f, e[0]});
+        while (!queue.empty()) {
+          const auto [d, x] = queue.top();
+          queue.pop();
+          if (d > dist[x]) continue;
+          if (x == e[1]) break;
+          for (std::uint32_t y : touching[x]) {
+            if ((x == e[0] && y == e[1]) || (x == e[1] && y == e[0])) continue;
+            const float nd = d + glm::length(sk.nodes[x].position - sk.nodes[y].position);
+            if (nd < dist[y] && step_inside(x, y)) {
+              dist[y] = nd, from[y] = x;
+              queue.push({nd, y});
+            }
+          }
+        }
+        if (from[e[1]] == UINT32_MAX) {
+          unrouted.push_back(e);
+          continue;
+        }
+        for (std::uint32_t y = e[1]; y != e[0]; y = from[y]) add_edge(from[y], y);
+      }
+      log_debug("skeleton: " + std::to_string(still.size() - unrouted.size()) + " of " +
+                std::to_string(still.size()) + " edges re-routed along touching regions");
+    }
+    // Last, a chain of new nodes along the centre points of a path of surface vertices from
+    // one end's vertices to the other's (Dijkstra over mesh edges, near the edge: centre points
+    // within |ab| of its midpoint; every step between centre points inside), thinned to the
+    // farthest visible centre point at each step; each new node takes its vertex from a node
+    // that keeps at least one. Where no such path stays near the edge, the same search over
+    // all the solid's inside centre points, from either end (a search seeded at one end can
+    // be walled in where the other's is not: camel's one bridge through the air, mpi's sheet
+    // links; s11fix).
+    std::vector<std::array<std::uint32_t, 2>> left;
+    if (!unrouted.empty()) {
+      std::vector<std::vector<std::uint32_t>> vertex_nbrs(n);
+      for (const Triangle& t : original.triangles)
+        for (int i = 0; i < 3; ++i) vertex_nbrs[t[i]].push_back(t[(i + 1) % 3]), vertex_nbrs[t[(i + 1) % 3]].push_back(t[i]);
+      // A step between two centre points that does not cross the surface is inside only when
+      // the points are: a vertex whose centre point fell back to its contracted position (a
+      // thin wing where no inside point was found) could route the chain through the air.
+      std::vector<std::int8_t> centre_in(n, -1);
+      auto inside_centre = [&](std::uint32_t k) {
+        if (centre_in[k] < 0) centre_in[k] = surface.bvh.inside(surface.centre[k]) ? 1 : 0;
+        return centre_in[k] == 1;
+      };
+      // `near_only`: the centre points within |ab| of the edge's midpoint (a local detour);
+      // without it, any inside centre point (the whole solid's, for an edge that the local
+      // search could not route round a deep concavity: camel, bones).
+      auto route_chain = [&](const std::array<std::uint32_t, 2>& e, bool near_only) {
+        const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+        const glm::vec3 mid = 0.5f * (pa + pb);
+        const float reach = glm::length(pb - pa);
+        auto near = [&](std::uint32_t k) {
+          return (!near_only || glm::length(surface.centre[k] - mid) <= reach) && inside_centre(k);
+        };
+        std::map<std::uint32_t, float> dist;
+        std::map<std::uint32_t, std::uint32_t> from;
+        using Item = std::pair<float, std::uint32_t>;
+        std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+        for (std::uint32_t k : sk.nodes[e[0]].vertices)
+          if (near(k) && !surface.bvh.segment_blocked(pa, surface.centre[k])) {
+            const float d = glm::length(surface.centre[k] - pa);
+            dist[k] = d, from[k] = UINT32_MAX;
+            queue.push({d, k});
+          }
+        std::uint32_t reached = UINT32_MAX;
+        std::size_t settled = 0;
+        while (!queue.empty() && settled < (near_only ? std::size_t{20000} : n)) {
+          const auto [d, k] = queue.top();
+          queue.pop();
+          if (d > dist[k]) continue;
+          ++settled;
+          if (node_of_vertex[k] == e[1] && !surface.bvh.segment_blocked(surface.centre[k], pb)) {
+            reached = k;
+            break;
+          }
+          for (std::uint32_t l : vertex_nbrs[k]) {
+            if (!near(l)) continue;
+            const float nd = d + glm::length(surface.centre[l] - surface.centre[k]);
+            const auto it = dist.find(l);
+            if ((it == dist.end() || nd < it->second) &&
+                !surface.bvh.segment_blocked(surface.centre[k], surface.centre[l])) {
+              dist[l] = nd, from[l] = k;
+              queue.push({nd, l});
+            }
+          }
+        }
+        if (reached == UINT32_MAX) return false;
+        std::vector<std::uint32_t> path;
+        for (std::uint32_t k = reached; k != UINT32_MAX; k = from[k]) path.push_back(k);
+        std::reverse(path.begin(), path.end());
+        // Waypoints: from the current point, the farthest path vertex whose centre it sees.
+        std::vector<std::uint32_t> waypoints;
+        glm::vec3 current = pa;
+        std::size_t i = 0;
+        while (surface.bvh.segment_blocked(current, pb) && i < path.size()) {
+          std::size_t j = path.size() - 1;
+          while (j > i && surface.bvh.segment_blocked(current, surface.centre[path[j]])) --j;
+          waypoints.push_back(path[j]);
+          current = surface.centre[path[j]];
+          i = j + 1;
+        }
+        bool ok = !surface.bvh.segment_blocked(current, pb);
+        std::map<std::uint32_t, std::size_t> taken;  // node -> vertices taken from it
+        for (std::uint32_t k : waypoints) {
+          const std::uint32_t node = node_of_vertex[k];
+          if (node == UINT32_MAX || sk.nodes[node].vertices.size() < 2 + taken[node]) ok = false;
+          ++taken[node];
+        }
+        if (!ok) return false;
+        std::uint32_t previous = e[0];
+        for (std::uint32_t k : waypoints) {
+          std::erase(sk.nodes[node_of_vertex[k]].vertices, k);
+          Node node;
+          node.position = surface.centre[k];
+          node.vertices = {k};
+          node.radius = surface.radius(node.position, node.vertices);
+          const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+          sk.nodes.push_back(std::move(node));
+          node_of_vertex[k] = id;
+          add_edge(previous, id);
+          previous = id;
+        }
+        add_edge(previous, e[1]);
+        return true;
+      };
+      for (const auto& e : unrouted)
+        if (!route_chain(e, true) && !route_chain(e, false) && !route_chain({e[1], e[0]}, false)) left.push_back(e);
+      log_debug("skeleton: " + std::to_string(unrouted.size() - left.size()) + " of " +
+                std::to_string(unrouted.size()) + " edges re-routed along centre points");
+    }
+    UnionFind parts(sk.nodes.size());
+    for (const auto& e : edges) parts.unite(e[0], e[1]);
+    for (const Triangle& t : sk.sheet_triangles) parts.unite(t[0], t[1]), parts.unite(t[1], t[2]);
+    for (const auto& e : left) {
+      const std::uint32_t ra = parts.find(e[0]), rb = parts.find(e[1]);
+      if (ra == rb) {
+        add_edge(e[0], e[1]);
+        through_air.insert(e);
+        continue;
+      }
+      std::vector<std::uint32_t> in_a, in_b;
+      for (std::uint32_t v = 0; v < sk.nodes.size(); ++v) {
+        const std::uint32_t r = parts.find(v);
+        if (r == ra) in_a.push_back(v);
+        else if (r == rb) in_b.push_back(v);
+      }
+      std::vector<std::pair<float, std::array<std::uint32_t, 2>>> pairs;
+      for (std::uint32_t a : in_a)
+        for (std::uint32_t b : in_b)
+          pairs.push_back({glm::length(sk.nodes[a].position - sk.nodes[b].position), {a, b}});
+      const std::size_t tried = std::min<std::size_t>(pairs.size(), 256);
+      std::partial_sort(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(tried), pairs.end());
+      std::array<std::uint32_t, 2> join = e;
+      through_air.insert(e);
+      for (std::size_t i = 0; i < tried; ++i) {
+        const auto [a, b] = pairs[i].second;
+        if (!surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position)) {
+          join = pairs[i].second;
+          through_air.erase(e);
+          break;
+        }
+      }
+      add_edge(join[0], join[1]);
+      parts.unite(join[0], join[1]);
+    }
+  }
+  return through_air;
+}
+
+// A solid of genus g has a skeleton with g independent cycles. Nodes added for unseen regions,
+// re-routed edges and sheet links can close more: with each sheet piece taken as one unit,
+// the curve edges that close a cycle (shortest edges first into a spanning forest) are
+// collected per mesh component, and all but the g longest of them are dropped.
+void prune_cycles(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
+                  const std::set<std::array<std::uint32_t, 2>>& through_air, const Mesh& original) {
+  const std::size_t n = original.positions.size();
+  UnionFind mesh_parts(n);
+  for (const Triangle& t : original.triangles) mesh_parts.unite(t[0], t[1]), mesh_parts.unite(t[1], t[2]);
+  std::map<std::uint32_t, long long> chi;
+  std::vector<std::uint8_t> used(n, 0);
+  for (const Triangle& t : original.triangles) {
+    const std::uint32_t r = mesh_parts.find(t[0]);
+    chi[r] += 1;
+    for (std::uint32_t v : t)
+      if (!used[v]) used[v] = 1, chi[r] += 1;
+  }
+  std::set<std::array<std::uint32_t, 2>> mesh_edges;
+  for (const Triangle& t : original.triangles)
+    for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+  for (const auto& e : mesh_edges) chi[mesh_parts.find(e[0])] -= 1;
+  // A sheet's own cycles (a band of sheet triangles around a hole) count against the genus:
+  // every closing curve edge below adds one independent cycle to those of the sheets (its
+  // ends are already joined), so a component keeps g minus its sheets' first Betti number.
+  // Where the sheets alone have more cycles than the genus, the holes are closed, shortest
+  // first: a fundamental cycle of the sheet edges that no set of sheet triangles bounds gets a
+  // fan of triangles from its first node (each fan removes exactly that cycle).
+  std::map<std::uint32_t, std::size_t> sheet_cycles;
+  {
+    std::map<std::uint32_t, Skeleton> sheets_of;
+    for (const Triangle& t : sk.sheet_triangles)
+      for (std::uint32_t node : t)
+        if (!sk.nodes[node].vertices.empty()) {
+          sheets_of[mesh_parts.find(sk.nodes[node].vertices.front())].sheet_triangles.push_back(t);
+          break;
+        }
+    for (auto& [root, part] : sheets_of) {
+      part.nodes.resize(sk.nodes.size());
+      const auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+      auto betti = static_cast<std::size_t>(cycle_count(part));
+      if (betti > g) {
+        // Fundamental cycles of a spanning forest of the sheet edges (shortest edges first)
+        // span every cycle of the sheets; one that is not a sum of triangle boundaries (its
+        // edge vector does not reduce to zero against the boundary columns, Z/2) is a hole.
+        std::map<std::array<std::uint32_t, 2>, std::uint32_t> edge_id;
+        for (const Triangle& t : part.sheet_triangles)
+          for (int i = 0; i < 3; ++i)
+            edge_id.emplace(std::array<std::uint32_t, 2>{std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])}, 0u);
+        std::uint32_t next_id = 0;
+        for (auto& [e, id] : edge_id) id = next_id++;
+        auto id_of = [&](std::uint32_t a, std::uint32_t b) { return edge_id.at({std::min(a, b), std::max(a, b)}); };
+        std::vector<std::vector<std::uint32_t>> columns;  // descending edge ids
+        std::map<std::uint32_t, std::size_t> pivot_of;
+        auto reduce = [&](std::vector<std::uint32_t> c) {
+          while (!c.empty()) {
+            const auto holder = pivot_of.find(c.front());
+            if (holder == pivot_of.end()) break;
+            std::vector<std::uint32_t> sum;
+            std::set_symmetric_difference(c.begin(), c.end(), columns[holder->second].begin(),
+                                          columns[holder->second].end(), std::back_inserter(sum), std::greater<>());
+            c = std::move(sum);
+          }
+          return c;
+        };
+        auto add_column = [&](std::vector<std::uint32_t> c) {
+          c = reduce(std::move(c));
+          if (c.empty()) return;
+          pivot_of.emplace(c.front(), columns.size());
+          columns.push_back(std::move(c));
+        };
+        for (const Triangle& t : part.sheet_triangles) {
+          std::vector<std::uint32_t> c{id_of(t[0], t[1]), id_of(t[1], t[2]), id_of(t[2], t[0])};
+          std::sort(c.begin(), c.end(), std::greater<>());
+          c.erase(std::unique(c.begin(), c.end()), c.end());
+          add_column(std::move(c));
+        }
+        std::vector<std::pair<float, std::array<std::uint32_t, 2>>> by_length;
+        for (const auto& [e, id] : edge_id)
+          by_length.push_back({glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position), e});
+        std::sort(by_length.begin(), by_length.end());
+        UnionFind tree(sk.nodes.size());
+        std::map<std::uint32_t, std::vector<std::uint32_t>> adjacency;
+        std::vector<std::array<std::uint32_t, 2>> non_tree;
+        for (const auto& [length, e] : by_length) {
+          if (tree.unite(e[0], e[1]))
+            adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+          else
+            non_tree.push_back(e);
+        }
+        std::vector<std::pair<float, std::vector<std::uint32_t>>> loops;
+        for (const auto& e : non_tree) {
+          std::map<std::uint32_t, std::uint32_t> from{{e[0], e[0]}};
+          std::vector<std::uint32_t> queue{e[0]};
+          for (std::size_t q = 0; q < queue.size() && !from.count(e[1]); ++q)
+            for (std::uint32_t y : adjacency[queue[q]])
+              if (from.emplace(y, queue[q]).second) queue.push_back(y);
+          std::vector<std::uint32_t> loop{e[1]};
+          while (loop.back() != e[0]) loop.push_back(from[loop.back()]);
+          float length = glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position);
+          for (std::size_t i = 0; i + 1 < loop.size(); ++i)
+            length += glm::length(sk.nodes[loop[i]].position - sk.nodes[loop[i + 1]].position);
+          loops.push_back({length, std::move(loop)});
+        }
+        std::sort(loops.begin(), loops.end());
+        // Shortest hole first: its loop gets a fan of triangles from its first node.
+        for (const auto& [length, loop] : loops) {
+          if (betti <= g) break;
+          std::vector<std::uint32_t> c;
+          for (std::size_t i = 0; i < loop.size(); ++i) c.push_back(id_of(loop[i], loop[(i + 1) % loop.size()]));
+          std::sort(c.begin(), c.end(), std::greater<>());
+          if (reduce(c).empty()) continue;  // bounds already
+          add_column(std::move(c));
+          for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+            part.sheet_triangles.push_back({loop[0], loop[i], loop[i + 1]});
+            sk.sheet_triangles.push_back({loop[0], loop[i], loop[i + 1]});
+          }
+          --betti;
+        }
+        betti = static_cast<std::size_t>(cycle_count(part));
+      }
+      sheet_cycles[root] = betti;
+    }
+  }
+  std::set<std::array<std::uint32_t, 2>> in_triangles;
+  UnionFind forest(sk.nodes.size());
+  for (const Triangle& t : sk.sheet_triangles) {
+    forest.unite(t[0], t[1]), forest.unite(t[1], t[2]);
+    for (int i = 0; i < 3; ++i) in_triangles.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
+  }
+  std::vector<std::pair<float, std::array<std::uint32_t, 2>>> by_length;
+  for (const auto& e : edges)
+    if (!in_triangles.count(e))
+      by_length.push_back({glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position), e});
+  std::sort(by_length.begin(), by_length.end());
+  // Edges through the air go into the forest last (so they close the cycles) and rank last.
+  std::stable_partition(by_length.begin(), by_length.end(),
+                        [&](const auto& x) { return !through_air.count(x.second); });
+  std::map<std::uint32_t, std::vector<std::pair<float, std::array<std::uint32_t, 2>>>> closing;
+  for (const auto& [length, e] : by_length)
+    if (!forest.unite(e[0], e[1]) && !sk.nodes[e[0]].vertices.empty())
+      closing[mesh_parts.find(sk.nodes[e[0]].vertices.front())].push_back(
+          {through_air.count(e) ? -length : length, e});
+  for (auto& [root, list] : closing) {
+    auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
+    if (const auto it = sheet_cycles.find(root); it != sheet_cycles.end()) g -= std::min(g, it->second);
+    std::sort(list.rbegin(), list.rend());
+    for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
+  }
+}
+
 // Terminal branches covered by the rest of the skeleton: a branch (a leaf and the chain of
 // degree-2 curve nodes up to the first node of degree >= 3) whose every node's ball lies in
 // what the rest of the skeleton stands for (the other curve nodes' balls swept along the
@@ -1165,438 +1609,8 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     }
     for (const auto& [key, value] : best) add_edge(key.first, value.second);
   }
-  // Edges whose segment leaves the solid (embedding refinement moved their ends apart around a
-  // concavity, or a sheet link crosses a fold) are replaced by a detour through the node c that
-  // minimizes |ac| + |cb| with both segments inside (of the 256 best); without one, where
-  // dropping the edge splits the skeleton, the two parts are joined again by the shortest
-  // segment between them that stays inside (of the 256 shortest pairs). An edge that neither
-  // finds is kept (a connected skeleton with its cycles comes first) and marked, so that the
-  // cycle pruning below drops it before any edge inside.
-  std::set<std::array<std::uint32_t, 2>> through_air;
-  {
-    std::vector<std::array<std::uint32_t, 2>> blocked;
-    for (const auto& e : edges)
-      if (surface.bvh.segment_blocked(sk.nodes[e[0]].position, sk.nodes[e[1]].position)) blocked.push_back(e);
-    auto inside_segment = [&](std::uint32_t a, std::uint32_t b) {
-      return !surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position);
-    };
-    if (!blocked.empty()) {
-      // Genus of the mesh component of each vertex (Euler characteristic per component).
-      std::vector<int> vertex_genus(n, 0);
-      {
-        UnionFind comp(n);
-        const std::map<std::uint32_t, int> genus = detail::component_genus(original, comp);
-        for (std::uint32_t k = 0; k < n; ++k) {
-          const auto it = genus.find(comp.find(k));
-          vertex_genus[k] = it == genus.end() ? 0 : it->second;
-        }
-      }
-      auto in_handle_body = [&](std::uint32_t node) {
-        return !sk.nodes[node].vertices.empty() && vertex_genus[sk.nodes[node].vertices.front()] > 0;
-      };
-      for (const auto& e : blocked) edges.erase(e);
-      std::vector<std::array<std::uint32_t, 2>> unresolved;
-      for (const auto& e : blocked) {
-        const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
-        std::vector<std::pair<float, std::uint32_t>> via;
-        for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
-          if (c != e[0] && c != e[1])
-            via.push_back({glm::length(sk.nodes[c].position - pa) + glm::length(sk.nodes[c].position - pb), c});
-        const std::size_t tried = std::min<std::size_t>(via.size(), 256);
-        std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
-        bool detoured = false;
-        // In a component of genus > 0, a detour along two edges the skeleton already has would
-        // drop the edge's cycle (a coarse handle's ring of three nodes: P, 3torus); those wait
-        // for a detour through a new node below.
-        const bool keep_cycle = in_handle_body(e[0]);
-        for (std::size_t i = 0; i < tried && !detoured; ++i)
-          if (!(keep_cycle && edges.count({std::min(e[0], via[i].second), std::max(e[0], via[i].second)}) &&
-                edges.count({std::min(e[1], via[i].second), std::max(e[1], via[i].second)})) &&
-              inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
-            add_edge(e[0], via[i].second);
-            add_edge(via[i].second, e[1]);
-            detoured = true;
-          }
-        if (!detoured) unresolved.push_back(e);
-      }
-      log_debug("skeleton: " + std::to_string(blocked.size()) + " edges leave the solid, " +
-                std::to_string(blocked.size() - unresolved.size()) + " detoured");
-      // Then a detour through a new node at the centre point of one of the two nodes' vertices
-      // (the vertex moves to the new node; its old node keeps at least one vertex).
-      std::vector<std::array<std::uint32_t, 2>> still;
-      for (const auto& e : unresolved) {
-        const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
-        std::vector<std::pair<float, std::pair<std::uint32_t, std::uint32_t>>> via;  // (vertex, node)
-        for (std::uint32_t end : e)
-          if (!sk.nodes[end].sheet && sk.nodes[end].vertices.size() > 1)
-            for (std::uint32_t k : sk.nodes[end].vertices)
-              via.push_back({glm::length(surface.centre[k] - pa) + glm::length(surface.centre[k] - pb), {k, end}});
-        const std::size_t tried = std::min<std::size_t>(via.size(), 256);
-        std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
-        bool detoured = false;
-        for (std::size_t i = 0; i < tried && !detoured; ++i) {
-          const auto [k, end] = via[i].second;
-          const glm::vec3 c = surface.centre[k];
-          if (sk.nodes[end].vertices.size() < 2 || !surface.bvh.inside(c) ||
-              surface.bvh.segment_blocked(pa, c) || surface.bvh.segment_blocked(c, pb))
-            continue;
-          std::erase(sk.nodes[end].vertices, k);
-          Node node;
-          node.position = c;
-          node.vertices = {k};
-          node.radius = surface.radius(c, node.vertices);
-          const auto id = static_cast<std::uint32_t>(sk.nodes.size());
-          sk.nodes.push_back(std::move(node));
-          node_of_vertex[k] = id;
-          add_edge(e[0], id);
-          add_edge(id, e[1]);
-          detoured = true;
-        }
-        if (!detoured) still.push_back(e);
-      }
-      // Then the shortest path from one end to the other through nodes whose surface regions
-      // touch (a mesh edge joins their vertices), every step inside the solid: the skeleton
-      // follows the surface around the concavity the edge cut across.
-      std::vector<std::array<std::uint32_t, 2>> unrouted;
-      if (!still.empty()) {
-        std::vector<std::vector<std::uint32_t>> touching(sk.nodes.size());
-        for (const Triangle& t : original.triangles)
-          for (int i = 0; i < 3; ++i) {
-            const std::uint32_t a = node_of_vertex[t[i]], b = node_of_vertex[t[(i + 1) % 3]];
-            if (a != b && a != UINT32_MAX && b != UINT32_MAX) touching[a].push_back(b);
-          }
-        for (auto& list : touching) {
-          std::sort(list.begin(), list.end());
-          list.erase(std::unique(list.begin(), list.end()), list.end());
-        }
-        std::map<std::array<std::uint32_t, 2>, bool> inside_cache;
-        auto step_inside = [&](std::uint32_t a, std::uint32_t b) {
-          const std::array<std::uint32_t, 2> key{std::min(a, b), std::max(a, b)};
-          const auto it = inside_cache.find(key);
-          if (it != inside_cache.end()) return it->second;
-          return inside_cache[key] = inside_segment(a, b);
-        };
-        for (const auto& e : still) {
-          std::vector<float> dist(sk.nodes.size(), std::numeric_limits<float>::infinity());
-          std::vector<std::uint32_t> from(sk.nodes.size(), UINT32_MAX);
-          using Item = std::pair<float, std::uint32_t>;
-          std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-          dist[e[0]] = 0.0f;
-          queue.push({0.0f, e[0]});
-          while (!queue.empty()) {
-            const auto [d, x] = queue.top();
-            queue.pop();
-            if (d > dist[x]) continue;
-            if (x == e[1]) break;
-            for (std::uint32_t y : touching[x]) {
-              if ((x == e[0] && y == e[1]) || (x == e[1] && y == e[0])) continue;
-              const float nd = d + glm::length(sk.nodes[x].position - sk.nodes[y].position);
-              if (nd < dist[y] && step_inside(x, y)) {
-                dist[y] = nd, from[y] = x;
-                queue.push({nd, y});
-              }
-            }
-          }
-          if (from[e[1]] == UINT32_MAX) {
-            unrouted.push_back(e);
-            continue;
-          }
-          for (std::uint32_t y = e[1]; y != e[0]; y = from[y]) add_edge(from[y], y);
-        }
-        log_debug("skeleton: " + std::to_string(still.size() - unrouted.size()) + " of " +
-                  std::to_string(still.size()) + " edges re-routed along touching regions");
-      }
-      // Last, a chain of new nodes along the centre points of a path of surface vertices from
-      // one end's vertices to the other's (Dijkstra over mesh edges, near the edge: centre points
-      // within |ab| of its midpoint; every step between centre points inside), thinned to the
-      // farthest visible centre point at each step; each new node takes its vertex from a node
-      // that keeps at least one. Where no such path stays near the edge, the same search over
-      // all the solid's inside centre points, from either end (a search seeded at one end can
-      // be walled in where the other's is not: camel's one bridge through the air, mpi's sheet
-      // links; s11fix).
-      std::vector<std::array<std::uint32_t, 2>> left;
-      if (!unrouted.empty()) {
-        std::vector<std::vector<std::uint32_t>> vertex_nbrs(n);
-        for (const Triangle& t : original.triangles)
-          for (int i = 0; i < 3; ++i) vertex_nbrs[t[i]].push_back(t[(i + 1) % 3]), vertex_nbrs[t[(i + 1) % 3]].push_back(t[i]);
-        // A step between two centre points that does not cross the surface is inside only when
-        // the points are: a vertex whose centre point fell back to its contracted position (a
-        // thin wing where no inside point was found) could route the chain through the air.
-        std::vector<std::int8_t> centre_in(n, -1);
-        auto inside_centre = [&](std::uint32_t k) {
-          if (centre_in[k] < 0) centre_in[k] = surface.bvh.inside(surface.centre[k]) ? 1 : 0;
-          return centre_in[k] == 1;
-        };
-        // `near_only`: the centre points within |ab| of the edge's midpoint (a local detour);
-        // without it, any inside centre point (the whole solid's, for an edge that the local
-        // search could not route round a deep concavity: camel, bones).
-        auto route_chain = [&](const std::array<std::uint32_t, 2>& e, bool near_only) {
-          const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
-          const glm::vec3 mid = 0.5f * (pa + pb);
-          const float reach = glm::length(pb - pa);
-          auto near = [&](std::uint32_t k) {
-            return (!near_only || glm::length(surface.centre[k] - mid) <= reach) && inside_centre(k);
-          };
-          std::map<std::uint32_t, float> dist;
-          std::map<std::uint32_t, std::uint32_t> from;
-          using Item = std::pair<float, std::uint32_t>;
-          std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-          for (std::uint32_t k : sk.nodes[e[0]].vertices)
-            if (near(k) && !surface.bvh.segment_blocked(pa, surface.centre[k])) {
-              const float d = glm::length(surface.centre[k] - pa);
-              dist[k] = d, from[k] = UINT32_MAX;
-              queue.push({d, k});
-            }
-          std::uint32_t reached = UINT32_MAX;
-          std::size_t settled = 0;
-          while (!queue.empty() && settled < (near_only ? std::size_t{20000} : n)) {
-            const auto [d, k] = queue.top();
-            queue.pop();
-            if (d > dist[k]) continue;
-            ++settled;
-            if (node_of_vertex[k] == e[1] && !surface.bvh.segment_blocked(surface.centre[k], pb)) {
-              reached = k;
-              break;
-            }
-            for (std::uint32_t l : vertex_nbrs[k]) {
-              if (!near(l)) continue;
-              const float nd = d + glm::length(surface.centre[l] - surface.centre[k]);
-              const auto it = dist.find(l);
-              if ((it == dist.end() || nd < it->second) &&
-                  !surface.bvh.segment_blocked(surface.centre[k], surface.centre[l])) {
-                dist[l] = nd, from[l] = k;
-                queue.push({nd, l});
-              }
-            }
-          }
-          if (reached == UINT32_MAX) return false;
-          std::vector<std::uint32_t> path;
-          for (std::uint32_t k = reached; k != UINT32_MAX; k = from[k]) path.push_back(k);
-          std::reverse(path.begin(), path.end());
-          // Waypoints: from the current point, the farthest path vertex whose centre it sees.
-          std::vector<std::uint32_t> waypoints;
-          glm::vec3 current = pa;
-          std::size_t i = 0;
-          while (surface.bvh.segment_blocked(current, pb) && i < path.size()) {
-            std::size_t j = path.size() - 1;
-            while (j > i && surface.bvh.segment_blocked(current, surface.centre[path[j]])) --j;
-            waypoints.push_back(path[j]);
-            current = surface.centre[path[j]];
-            i = j + 1;
-          }
-          bool ok = !surface.bvh.segment_blocked(current, pb);
-          std::map<std::uint32_t, std::size_t> taken;  // node -> vertices taken from it
-          for (std::uint32_t k : waypoints) {
-            const std::uint32_t node = node_of_vertex[k];
-            if (node == UINT32_MAX || sk.nodes[node].vertices.size() < 2 + taken[node]) ok = false;
-            ++taken[node];
-          }
-          if (!ok) return false;
-          std::uint32_t previous = e[0];
-          for (std::uint32_t k : waypoints) {
-            std::erase(sk.nodes[node_of_vertex[k]].vertices, k);
-            Node node;
-            node.position = surface.centre[k];
-            node.vertices = {k};
-            node.radius = surface.radius(node.position, node.vertices);
-            const auto id = static_cast<std::uint32_t>(sk.nodes.size());
-            sk.nodes.push_back(std::move(node));
-            node_of_vertex[k] = id;
-            add_edge(previous, id);
-            previous = id;
-          }
-          add_edge(previous, e[1]);
-          return true;
-        };
-        for (const auto& e : unrouted)
-          if (!route_chain(e, true) && !route_chain(e, false) && !route_chain({e[1], e[0]}, false)) left.push_back(e);
-        log_debug("skeleton: " + std::to_string(unrouted.size() - left.size()) + " of " +
-                  std::to_string(unrouted.size()) + " edges re-routed along centre points");
-      }
-      UnionFind parts(sk.nodes.size());
-      for (const auto& e : edges) parts.unite(e[0], e[1]);
-      for (const Triangle& t : sk.sheet_triangles) parts.unite(t[0], t[1]), parts.unite(t[1], t[2]);
-      for (const auto& e : left) {
-        const std::uint32_t ra = parts.find(e[0]), rb = parts.find(e[1]);
-        if (ra == rb) {
-          add_edge(e[0], e[1]);
-          through_air.insert(e);
-          continue;
-        }
-        std::vector<std::uint32_t> in_a, in_b;
-        for (std::uint32_t v = 0; v < sk.nodes.size(); ++v) {
-          const std::uint32_t r = parts.find(v);
-          if (r == ra) in_a.push_back(v);
-          else if (r == rb) in_b.push_back(v);
-        }
-        std::vector<std::pair<float, std::array<std::uint32_t, 2>>> pairs;
-        for (std::uint32_t a : in_a)
-          for (std::uint32_t b : in_b)
-            pairs.push_back({glm::length(sk.nodes[a].position - sk.nodes[b].position), {a, b}});
-        const std::size_t tried = std::min<std::size_t>(pairs.size(), 256);
-        std::partial_sort(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(tried), pairs.end());
-        std::array<std::uint32_t, 2> join = e;
-        through_air.insert(e);
-        for (std::size_t i = 0; i < tried; ++i) {
-          const auto [a, b] = pairs[i].second;
-          if (!surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position)) {
-            join = pairs[i].second;
-            through_air.erase(e);
-            break;
-          }
-        }
-        add_edge(join[0], join[1]);
-        parts.unite(join[0], join[1]);
-      }
-    }
-  }
-  // A solid of genus g has a skeleton with g independent cycles. Nodes added for unseen regions,
-  // re-routed edges and sheet links can close more: with each sheet piece taken as one unit,
-  // the curve edges that close a cycle (shortest edges first into a spanning forest) are
-  // collected per mesh component, and all but the g longest of them are dropped.
-  {
-    UnionFind mesh_parts(n);
-    for (const Triangle& t : original.triangles) mesh_parts.unite(t[0], t[1]), mesh_parts.unite(t[1], t[2]);
-    std::map<std::uint32_t, long long> chi;
-    std::vector<std::uint8_t> used(n, 0);
-    for (const Triangle& t : original.triangles) {
-      const std::uint32_t r = mesh_parts.find(t[0]);
-      chi[r] += 1;
-      for (std::uint32_t v : t)
-        if (!used[v]) used[v] = 1, chi[r] += 1;
-    }
-    std::set<std::array<std::uint32_t, 2>> mesh_edges;
-    for (const Triangle& t : original.triangles)
-      for (int i = 0; i < 3; ++i) mesh_edges.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
-    for (const auto& e : mesh_edges) chi[mesh_parts.find(e[0])] -= 1;
-    // A sheet's own cycles (a band of sheet triangles around a hole) count against the genus:
-    // every closing curve edge below adds one independent cycle to those of the sheets (its
-    // ends are already joined), so a component keeps g minus its sheets' first Betti number.
-    // Where the sheets alone have more cycles than the genus, the holes are closed, shortest
-    // first: a fundamental cycle of the sheet edges that no set of sheet triangles bounds gets a
-    // fan of triangles from its first node (each fan removes exactly that cycle).
-    std::map<std::uint32_t, std::size_t> sheet_cycles;
-    {
-      std::map<std::uint32_t, Skeleton> sheets_of;
-      for (const Triangle& t : sk.sheet_triangles)
-        for (std::uint32_t node : t)
-          if (!sk.nodes[node].vertices.empty()) {
-            sheets_of[mesh_parts.find(sk.nodes[node].vertices.front())].sheet_triangles.push_back(t);
-            break;
-          }
-      for (auto& [root, part] : sheets_of) {
-        part.nodes.resize(sk.nodes.size());
-        const auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
-        auto betti = static_cast<std::size_t>(cycle_count(part));
-        if (betti > g) {
-          // Fundamental cycles of a spanning forest of the sheet edges (shortest edges first)
-          // span every cycle of the sheets; one that is not a sum of triangle boundaries (its
-          // edge vector does not reduce to zero against the boundary columns, Z/2) is a hole.
-          std::map<std::array<std::uint32_t, 2>, std::uint32_t> edge_id;
-          for (const Triangle& t : part.sheet_triangles)
-            for (int i = 0; i < 3; ++i)
-              edge_id.emplace(std::array<std::uint32_t, 2>{std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])}, 0u);
-          std::uint32_t next_id = 0;
-          for (auto& [e, id] : edge_id) id = next_id++;
-          auto id_of = [&](std::uint32_t a, std::uint32_t b) { return edge_id.at({std::min(a, b), std::max(a, b)}); };
-          std::vector<std::vector<std::uint32_t>> columns;  // descending edge ids
-          std::map<std::uint32_t, std::size_t> pivot_of;
-          auto reduce = [&](std::vector<std::uint32_t> c) {
-            while (!c.empty()) {
-              const auto holder = pivot_of.find(c.front());
-              if (holder == pivot_of.end()) break;
-              std::vector<std::uint32_t> sum;
-              std::set_symmetric_difference(c.begin(), c.end(), columns[holder->second].begin(),
-                                            columns[holder->second].end(), std::back_inserter(sum), std::greater<>());
-              c = std::move(sum);
-            }
-            return c;
-          };
-          auto add_column = [&](std::vector<std::uint32_t> c) {
-            c = reduce(std::move(c));
-            if (c.empty()) return;
-            pivot_of.emplace(c.front(), columns.size());
-            columns.push_back(std::move(c));
-          };
-          for (const Triangle& t : part.sheet_triangles) {
-            std::vector<std::uint32_t> c{id_of(t[0], t[1]), id_of(t[1], t[2]), id_of(t[2], t[0])};
-            std::sort(c.begin(), c.end(), std::greater<>());
-            c.erase(std::unique(c.begin(), c.end()), c.end());
-            add_column(std::move(c));
-          }
-          std::vector<std::pair<float, std::array<std::uint32_t, 2>>> by_length;
-          for (const auto& [e, id] : edge_id)
-            by_length.push_back({glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position), e});
-          std::sort(by_length.begin(), by_length.end());
-          UnionFind tree(sk.nodes.size());
-          std::map<std::uint32_t, std::vector<std::uint32_t>> adjacency;
-          std::vector<std::array<std::uint32_t, 2>> non_tree;
-          for (const auto& [length, e] : by_length) {
-            if (tree.unite(e[0], e[1]))
-              adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
-            else
-              non_tree.push_back(e);
-          }
-          std::vector<std::pair<float, std::vector<std::uint32_t>>> loops;
-          for (const auto& e : non_tree) {
-            std::map<std::uint32_t, std::uint32_t> from{{e[0], e[0]}};
-            std::vector<std::uint32_t> queue{e[0]};
-            for (std::size_t q = 0; q < queue.size() && !from.count(e[1]); ++q)
-              for (std::uint32_t y : adjacency[queue[q]])
-                if (from.emplace(y, queue[q]).second) queue.push_back(y);
-            std::vector<std::uint32_t> loop{e[1]};
-            while (loop.back() != e[0]) loop.push_back(from[loop.back()]);
-            float length = glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position);
-            for (std::size_t i = 0; i + 1 < loop.size(); ++i)
-              length += glm::length(sk.nodes[loop[i]].position - sk.nodes[loop[i + 1]].position);
-            loops.push_back({length, std::move(loop)});
-          }
-          std::sort(loops.begin(), loops.end());
-          // Shortest hole first: its loop gets a fan of triangles from its first node.
-          for (const auto& [length, loop] : loops) {
-            if (betti <= g) break;
-            std::vector<std::uint32_t> c;
-            for (std::size_t i = 0; i < loop.size(); ++i) c.push_back(id_of(loop[i], loop[(i + 1) % loop.size()]));
-            std::sort(c.begin(), c.end(), std::greater<>());
-            if (reduce(c).empty()) continue;  // bounds already
-            add_column(std::move(c));
-            for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
-              part.sheet_triangles.push_back({loop[0], loop[i], loop[i + 1]});
-              sk.sheet_triangles.push_back({loop[0], loop[i], loop[i + 1]});
-            }
-            --betti;
-          }
-          betti = static_cast<std::size_t>(cycle_count(part));
-        }
-        sheet_cycles[root] = betti;
-      }
-    }
-    std::set<std::array<std::uint32_t, 2>> in_triangles;
-    UnionFind forest(sk.nodes.size());
-    for (const Triangle& t : sk.sheet_triangles) {
-      forest.unite(t[0], t[1]), forest.unite(t[1], t[2]);
-      for (int i = 0; i < 3; ++i) in_triangles.insert({std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])});
-    }
-    std::vector<std::pair<float, std::array<std::uint32_t, 2>>> by_length;
-    for (const auto& e : edges)
-      if (!in_triangles.count(e))
-        by_length.push_back({glm::length(sk.nodes[e[0]].position - sk.nodes[e[1]].position), e});
-    std::sort(by_length.begin(), by_length.end());
-    // Edges through the air go into the forest last (so they close the cycles) and rank last.
-    std::stable_partition(by_length.begin(), by_length.end(),
-                          [&](const auto& x) { return !through_air.count(x.second); });
-    std::map<std::uint32_t, std::vector<std::pair<float, std::array<std::uint32_t, 2>>>> closing;
-    for (const auto& [length, e] : by_length)
-      if (!forest.unite(e[0], e[1]) && !sk.nodes[e[0]].vertices.empty())
-        closing[mesh_parts.find(sk.nodes[e[0]].vertices.front())].push_back(
-            {through_air.count(e) ? -length : length, e});
-    for (auto& [root, list] : closing) {
-      auto g = static_cast<std::size_t>(std::max(0LL, (2 - chi[root]) / 2));
-      if (const auto it = sheet_cycles.find(root); it != sheet_cycles.end()) g -= std::min(g, it->second);
-      std::sort(list.rbegin(), list.rend());
-      for (std::size_t k = g; k < list.size(); ++k) edges.erase(list[k].second);
-    }
-  }
+  const std::set<std::array<std::uint32_t, 2>> through_air = route_edges_inside(sk, edges, node_of_vertex, surface);
+  prune_cycles(sk, edges, through_air, original);
   if (options.prune_branches) prune_covered_branches(sk, edges, node_of_vertex);
   // The tip node of a curve leaf (see below); nothing when `leaf` is not a curve leaf of
   // `adjacency` with at least two vertices.
