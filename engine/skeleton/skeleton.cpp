@@ -35,6 +35,9 @@
 namespace sdfkit::skeleton {
 namespace {
 
+// Skeleton edges, each as (smaller node index, larger node index).
+using EdgeSet = std::set<std::array<std::uint32_t, 2>>;
+
 // Everything about the input surface that node placement and visibility need.
 struct Surface {
   const Mesh& original;
@@ -391,9 +394,8 @@ std::vector<std::uint32_t> remove_nodes(Skeleton& sk, const std::vector<std::uin
 }
 
 // `edges` with their ends renumbered by `index` (remove_nodes); none may end at a dropped node.
-std::set<std::array<std::uint32_t, 2>> renumbered(const std::set<std::array<std::uint32_t, 2>>& edges,
-                                                  const std::vector<std::uint32_t>& index) {
-  std::set<std::array<std::uint32_t, 2>> out;
+EdgeSet renumbered(const EdgeSet& edges, const std::vector<std::uint32_t>& index) {
+  EdgeSet out;
   for (const auto& e : edges) out.insert({std::min(index[e[0]], index[e[1]]), std::max(index[e[0]], index[e[1]])});
   return out;
 }
@@ -405,12 +407,10 @@ std::set<std::array<std::uint32_t, 2>> renumbered(const std::set<std::array<std:
 // segment between them that stays inside (of the 256 shortest pairs). An edge that neither
 // finds is kept (a connected skeleton with its cycles comes first) and returned, so that the
 // cycle pruning (prune_cycles) drops it before any edge inside.
-std::set<std::array<std::uint32_t, 2>> route_edges_inside(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
-                                                          std::vector<std::uint32_t>& node_of_vertex,
-                                                          const Surface& surface) {
+EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_of_vertex, const Surface& surface) {
   const Mesh& original = surface.original;
   const std::size_t n = original.positions.size();
-  std::set<std::array<std::uint32_t, 2>> through_air;
+  EdgeSet through_air;
   auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
     if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
   };
@@ -696,8 +696,7 @@ std::set<std::array<std::uint32_t, 2>> route_edges_inside(Skeleton& sk, std::set
 // re-routed edges and sheet links can close more: with each sheet piece taken as one unit,
 // the curve edges that close a cycle (shortest edges first into a spanning forest) are
 // collected per mesh component, and all but the g longest of them are dropped.
-void prune_cycles(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
-                  const std::set<std::array<std::uint32_t, 2>>& through_air, const Mesh& original) {
+void prune_cycles(Skeleton& sk, EdgeSet& edges, const EdgeSet& through_air, const Mesh& original) {
   const std::size_t n = original.positions.size();
   UnionFind mesh_parts(n);
   for (const Triangle& t : original.triangles) mesh_parts.unite(t[0], t[1]), mesh_parts.unite(t[1], t[2]);
@@ -842,6 +841,144 @@ void prune_cycles(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
   }
 }
 
+// The tip node of a curve leaf (SkeletonOptions::extend_leaves, in build()); nothing when `leaf`
+// is not a curve leaf of `adjacency` with at least two vertices.
+void extend_tip(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_of_vertex, const Surface& surface,
+                std::uint32_t leaf, const std::vector<std::vector<std::uint32_t>>& adjacency) {
+  const Mesh& original = surface.original;
+  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
+    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
+  };
+  if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) return;
+  const glm::vec3 p = sk.nodes[leaf].position, q = sk.nodes[adjacency[leaf].front()].position;
+  const float len = glm::length(p - q);
+  if (!(len > 0.0f)) return;
+  const glm::vec3 dir = (p - q) / len;
+  std::uint32_t far_vertex = sk.nodes[leaf].vertices.front();
+  for (std::uint32_t k : sk.nodes[leaf].vertices)
+    if (glm::dot(original.positions[k] - p, dir) > glm::dot(original.positions[far_vertex] - p, dir)) far_vertex = k;
+  const glm::vec3 tip = surface.centre[far_vertex];
+  if (glm::dot(tip - p, dir) <= sk.nodes[leaf].radius || !surface.bvh.inside(tip) ||
+      surface.bvh.segment_blocked(p, tip))
+    return;
+  const glm::vec3 mid = 0.5f * (p + tip);
+  std::vector<std::uint32_t> moved, kept;
+  for (std::uint32_t k : sk.nodes[leaf].vertices)
+    (glm::dot(original.positions[k] - mid, dir) > 0.0f && surface.sees(k, tip) ? moved : kept).push_back(k);
+  if (moved.empty() || kept.empty()) return;
+  // The node sits where every node sits, at the centre of its vertices' region (the mean of
+  // their centre points), when that is inside and joined to the leaf through the solid; the tip
+  // itself only decided that there is room. At the tip, the extreme vertex's centre point lies
+  // within SDF/2 of the surface, nearer than any node: over CGAL's set, tip nodes there ended
+  // up to 9 % of the diagonal beyond CGAL's leaves (diplodocus's and the hand's missed ones).
+  glm::dvec3 mean(0.0);
+  for (std::uint32_t k : moved) mean += glm::dvec3(surface.centre[k]);
+  glm::vec3 at(mean / static_cast<double>(moved.size()));
+  if (!surface.bvh.inside(at) || surface.bvh.segment_blocked(p, at)) at = tip;
+  sk.nodes[leaf].vertices = std::move(kept);
+  sk.nodes[leaf].radius = surface.radius(p, sk.nodes[leaf].vertices);
+  Node node;
+  node.position = at;
+  node.vertices = std::move(moved);
+  node.radius = surface.radius(at, node.vertices);
+  const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+  for (std::uint32_t k : node.vertices) node_of_vertex[k] = id;
+  sk.nodes.push_back(std::move(node));
+  add_edge(leaf, id);
+}
+
+// Curve edges follow the limb between their nodes (s11shape). Grouping leaves nodes up to the
+// grouping distance apart (a bear: 8 nodes), and a straight edge between two of them is a chord
+// of the tube, off its centre wherever the limb bends (over CGAL's set the chords, not the
+// nodes, were most of the distance to CGAL's curves: bear 0.56 % of the diagonal at the nodes,
+// 2.59 % along the edges). Each curve edge (a, b) longer than two local radii is cut into
+// cross-sections one local radius r = (r_a + r_b) / 2 apart: the vertices of a and b that
+// project between them along ab, whose centre points lie within r of the segment (the tube of
+// this edge, not another branch of a junction), go to the section nearest their projection,
+// and a section node sits at the mean of its vertices' centre points (the centre of that
+// cross-section, as the embedding refinement places every node). A section keeps the
+// vertices that see it and needs three; the edge becomes the chain through its sections
+// only when every section node is inside and every link of the chain stays inside, else it
+// is left as it was. a and b keep their positions and at least one vertex each. Each vertex
+// moves at most once; a chain has the edge's ends, so leaves, junctions and cycles are
+// unchanged.
+void add_sections(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_of_vertex, std::vector<std::uint8_t>& moved,
+                  const Surface& surface, const std::vector<std::array<std::uint32_t, 2>>& current) {
+  const Mesh& original = surface.original;
+  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
+    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
+  };
+  for (const auto& e : current) {
+  const std::uint32_t a = e[0], b = e[1];
+  if (sk.nodes[a].sheet || sk.nodes[b].sheet) continue;
+  const glm::vec3 pa = sk.nodes[a].position, pb = sk.nodes[b].position;
+  const float len = glm::length(pb - pa);
+  const float r = 0.5f * (sk.nodes[a].radius + sk.nodes[b].radius);
+  if (!(r > 0.0f) || !(len > 2.0f * r)) continue;
+  const glm::vec3 dir = (pb - pa) / len;
+  const int sections = static_cast<int>(std::lround(len / r));
+  const float spacing = len / static_cast<float>(sections);
+  std::vector<std::vector<std::uint32_t>> slice(static_cast<std::size_t>(sections));
+  std::size_t left_a = sk.nodes[a].vertices.size(), left_b = sk.nodes[b].vertices.size();
+  for (const std::uint32_t end : {a, b})
+    for (std::uint32_t k : sk.nodes[end].vertices) {
+      if (moved[k]) continue;
+      const float t = glm::dot(original.positions[k] - pa, dir);
+      const int j = static_cast<int>(std::lround(t / spacing));
+      if (j < 1 || j >= sections) continue;
+      const glm::vec3 c = surface.centre[k];
+      const float tc = std::clamp(glm::dot(c - pa, dir), 0.0f, len);
+      if (glm::length(c - (pa + tc * dir)) > r) continue;
+      slice[static_cast<std::size_t>(j)].push_back(k);
+    }
+  std::vector<std::pair<glm::vec3, std::vector<std::uint32_t>>> chain;
+  for (const auto& part : slice) {
+    if (part.size() < 3) continue;
+    glm::dvec3 mean(0.0);
+    for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
+    const glm::vec3 at(mean / static_cast<double>(part.size()));
+    if (!surface.bvh.inside(at)) continue;
+    std::vector<std::uint32_t> seeing;
+    for (std::uint32_t k : part)
+      if (surface.sees(k, at)) seeing.push_back(k);
+    if (seeing.size() < 3) continue;
+    chain.push_back({at, std::move(seeing)});
+  }
+  if (chain.empty()) continue;
+  for (const auto& [at, part] : chain)
+    for (std::uint32_t k : part) (node_of_vertex[k] == a ? left_a : left_b)--;
+  bool ok = left_a > 0 && left_b > 0;
+  glm::vec3 previous = pa;
+  for (const auto& [at, part] : chain) {
+    ok = ok && !surface.bvh.segment_blocked(previous, at);
+    previous = at;
+  }
+  ok = ok && !surface.bvh.segment_blocked(previous, pb);
+  if (!ok) continue;
+  std::set<std::uint32_t> leaving;
+  for (const auto& [at, part] : chain) leaving.insert(part.begin(), part.end());
+  for (const std::uint32_t end : {a, b}) {
+    std::vector<std::uint32_t>& v = sk.nodes[end].vertices;
+    v.erase(std::remove_if(v.begin(), v.end(), [&](std::uint32_t k) { return leaving.count(k) > 0; }), v.end());
+    sk.nodes[end].radius = surface.radius(sk.nodes[end].position, v);
+  }
+  edges.erase(e);
+  std::uint32_t from = a;
+  for (auto& [at, part] : chain) {
+    Node node;
+    node.position = at;
+    node.radius = surface.radius(at, part);
+    const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+    for (std::uint32_t k : part) node_of_vertex[k] = id, moved[k] = 1;
+    node.vertices = std::move(part);
+    sk.nodes.push_back(std::move(node));
+    add_edge(from, id);
+    from = id;
+  }
+  add_edge(from, b);
+  }
+}
+
 // Terminal branches covered by the rest of the skeleton: a branch (a leaf and the chain of
 // degree-2 curve nodes up to the first node of degree >= 3) whose every node's ball lies in
 // what the rest of the skeleton stands for (the other curve nodes' balls swept along the
@@ -855,8 +992,7 @@ void prune_cycles(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
 // over CGAL's data set stayed for that.) Such branches are merged into their
 // junction, the one that reaches least out of the union first, while the junction keeps
 // degree >= 3 (a junction never becomes a leaf, so no limb is shortened step by step).
-void prune_covered_branches(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges,
-                            std::vector<std::uint32_t>& node_of_vertex) {
+void prune_covered_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_of_vertex) {
   std::vector<std::uint8_t> dead(sk.nodes.size(), 0);
   for (bool changed = true; changed;) {
     changed = false;
@@ -965,7 +1101,7 @@ void prune_covered_branches(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>
 // nodes: before them a limb's curve is a chord between grouped nodes, and the returning rim
 // lies off it near the hoof (the bull's folded leg then stayed), while earlier leaves moved
 // bunny00's ear branch 0.047 -> 0.086 of the diagonal from its tip.
-void unfold_branches(Skeleton& sk, std::set<std::array<std::uint32_t, 2>>& edges, const Surface& surface) {
+void unfold_branches(Skeleton& sk, EdgeSet& edges, const Surface& surface) {
   std::size_t unfolded = 0;
   for (std::size_t round = 0; round < sk.nodes.size(); ++round) {
     std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
@@ -1559,7 +1695,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   add_sheet_nodes(surface, in_sheet, sheet_point, options.sheet_spacing * diag, sk.nodes, node_of_vertex);
   watch.lap("sheet nodes");
 
-  std::set<std::array<std::uint32_t, 2>> edges;
+  EdgeSet edges;
   auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
     if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
   };
@@ -1609,49 +1745,9 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     }
     for (const auto& [key, value] : best) add_edge(key.first, value.second);
   }
-  const std::set<std::array<std::uint32_t, 2>> through_air = route_edges_inside(sk, edges, node_of_vertex, surface);
+  const EdgeSet through_air = route_edges_inside(sk, edges, node_of_vertex, surface);
   prune_cycles(sk, edges, through_air, original);
   if (options.prune_branches) prune_covered_branches(sk, edges, node_of_vertex);
-  // The tip node of a curve leaf (see below); nothing when `leaf` is not a curve leaf of
-  // `adjacency` with at least two vertices.
-  auto extend_tip = [&](std::uint32_t leaf, const std::vector<std::vector<std::uint32_t>>& adjacency) {
-    if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) return;
-    const glm::vec3 p = sk.nodes[leaf].position, q = sk.nodes[adjacency[leaf].front()].position;
-    const float len = glm::length(p - q);
-    if (!(len > 0.0f)) return;
-    const glm::vec3 dir = (p - q) / len;
-    std::uint32_t far_vertex = sk.nodes[leaf].vertices.front();
-    for (std::uint32_t k : sk.nodes[leaf].vertices)
-      if (glm::dot(original.positions[k] - p, dir) > glm::dot(original.positions[far_vertex] - p, dir)) far_vertex = k;
-    const glm::vec3 tip = surface.centre[far_vertex];
-    if (glm::dot(tip - p, dir) <= sk.nodes[leaf].radius || !surface.bvh.inside(tip) ||
-        surface.bvh.segment_blocked(p, tip))
-      return;
-    const glm::vec3 mid = 0.5f * (p + tip);
-    std::vector<std::uint32_t> moved, kept;
-    for (std::uint32_t k : sk.nodes[leaf].vertices)
-      (glm::dot(original.positions[k] - mid, dir) > 0.0f && surface.sees(k, tip) ? moved : kept).push_back(k);
-    if (moved.empty() || kept.empty()) return;
-    // The node sits where every node sits, at the centre of its vertices' region (the mean of
-    // their centre points), when that is inside and joined to the leaf through the solid; the tip
-    // itself only decided that there is room. At the tip, the extreme vertex's centre point lies
-    // within SDF/2 of the surface, nearer than any node: over CGAL's set, tip nodes there ended
-    // up to 9 % of the diagonal beyond CGAL's leaves (diplodocus's and the hand's missed ones).
-    glm::dvec3 mean(0.0);
-    for (std::uint32_t k : moved) mean += glm::dvec3(surface.centre[k]);
-    glm::vec3 at(mean / static_cast<double>(moved.size()));
-    if (!surface.bvh.inside(at) || surface.bvh.segment_blocked(p, at)) at = tip;
-    sk.nodes[leaf].vertices = std::move(kept);
-    sk.nodes[leaf].radius = surface.radius(p, sk.nodes[leaf].vertices);
-    Node node;
-    node.position = at;
-    node.vertices = std::move(moved);
-    node.radius = surface.radius(at, node.vertices);
-    const auto id = static_cast<std::uint32_t>(sk.nodes.size());
-    for (std::uint32_t k : node.vertices) node_of_vertex[k] = id;
-    sk.nodes.push_back(std::move(node));
-    add_edge(leaf, id);
-  };
   // Leaves reach the end of their limb: a curve leaf's node sits at the centre of its vertices'
   // region, short of the limb's tip. Its vertex farthest along the direction from its neighbour
   // gives the tip (that vertex's centre point); when the tip lies over a node radius beyond the
@@ -1691,96 +1787,13 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       std::replace(adjacency[h].begin(), adjacency[h].end(), f, leaf);
     }
     const std::size_t count = sk.nodes.size();
-    for (std::uint32_t leaf = 0; leaf < count; ++leaf) extend_tip(leaf, adjacency);
+    for (std::uint32_t leaf = 0; leaf < count; ++leaf) extend_tip(sk, edges, node_of_vertex, surface, leaf, adjacency);
   }
-  // Curve edges follow the limb between their nodes (s11shape). Grouping leaves nodes up to the
-  // grouping distance apart (a bear: 8 nodes), and a straight edge between two of them is a chord
-  // of the tube, off its centre wherever the limb bends (over CGAL's set the chords, not the
-  // nodes, were most of the distance to CGAL's curves: bear 0.56 % of the diagonal at the nodes,
-  // 2.59 % along the edges). Each curve edge (a, b) longer than two local radii is cut into
-  // cross-sections one local radius r = (r_a + r_b) / 2 apart: the vertices of a and b that
-  // project between them along ab, whose centre points lie within r of the segment (the tube of
-  // this edge, not another branch of a junction), go to the section nearest their projection,
-  // and a section node sits at the mean of its vertices' centre points (the centre of that
-  // cross-section, as the embedding refinement places every node). A section keeps the
-  // vertices that see it and needs three; the edge becomes the chain through its sections
-  // only when every section node is inside and every link of the chain stays inside, else it
-  // is left as it was. a and b keep their positions and at least one vertex each. Each vertex
-  // moves at most once; a chain has the edge's ends, so leaves, junctions and cycles are
-  // unchanged.
+  // Cross-section nodes along the curve edges (add_sections); `moved` marks the vertices that
+  // moved to a section, each at most once, here and for the protrusions' edges below.
   std::vector<std::uint8_t> moved(n, 0);
-  auto add_sections = [&](const std::vector<std::array<std::uint32_t, 2>>& current) {
-    for (const auto& e : current) {
-    const std::uint32_t a = e[0], b = e[1];
-    if (sk.nodes[a].sheet || sk.nodes[b].sheet) continue;
-    const glm::vec3 pa = sk.nodes[a].position, pb = sk.nodes[b].position;
-    const float len = glm::length(pb - pa);
-    const float r = 0.5f * (sk.nodes[a].radius + sk.nodes[b].radius);
-    if (!(r > 0.0f) || !(len > 2.0f * r)) continue;
-    const glm::vec3 dir = (pb - pa) / len;
-    const int sections = static_cast<int>(std::lround(len / r));
-    const float spacing = len / static_cast<float>(sections);
-    std::vector<std::vector<std::uint32_t>> slice(static_cast<std::size_t>(sections));
-    std::size_t left_a = sk.nodes[a].vertices.size(), left_b = sk.nodes[b].vertices.size();
-    for (const std::uint32_t end : {a, b})
-      for (std::uint32_t k : sk.nodes[end].vertices) {
-        if (moved[k]) continue;
-        const float t = glm::dot(original.positions[k] - pa, dir);
-        const int j = static_cast<int>(std::lround(t / spacing));
-        if (j < 1 || j >= sections) continue;
-        const glm::vec3 c = surface.centre[k];
-        const float tc = std::clamp(glm::dot(c - pa, dir), 0.0f, len);
-        if (glm::length(c - (pa + tc * dir)) > r) continue;
-        slice[static_cast<std::size_t>(j)].push_back(k);
-      }
-    std::vector<std::pair<glm::vec3, std::vector<std::uint32_t>>> chain;
-    for (const auto& part : slice) {
-      if (part.size() < 3) continue;
-      glm::dvec3 mean(0.0);
-      for (std::uint32_t k : part) mean += glm::dvec3(surface.centre[k]);
-      const glm::vec3 at(mean / static_cast<double>(part.size()));
-      if (!surface.bvh.inside(at)) continue;
-      std::vector<std::uint32_t> seeing;
-      for (std::uint32_t k : part)
-        if (surface.sees(k, at)) seeing.push_back(k);
-      if (seeing.size() < 3) continue;
-      chain.push_back({at, std::move(seeing)});
-    }
-    if (chain.empty()) continue;
-    for (const auto& [at, part] : chain)
-      for (std::uint32_t k : part) (node_of_vertex[k] == a ? left_a : left_b)--;
-    bool ok = left_a > 0 && left_b > 0;
-    glm::vec3 previous = pa;
-    for (const auto& [at, part] : chain) {
-      ok = ok && !surface.bvh.segment_blocked(previous, at);
-      previous = at;
-    }
-    ok = ok && !surface.bvh.segment_blocked(previous, pb);
-    if (!ok) continue;
-    std::set<std::uint32_t> leaving;
-    for (const auto& [at, part] : chain) leaving.insert(part.begin(), part.end());
-    for (const std::uint32_t end : {a, b}) {
-      std::vector<std::uint32_t>& v = sk.nodes[end].vertices;
-      v.erase(std::remove_if(v.begin(), v.end(), [&](std::uint32_t k) { return leaving.count(k) > 0; }), v.end());
-      sk.nodes[end].radius = surface.radius(sk.nodes[end].position, v);
-    }
-    edges.erase(e);
-    std::uint32_t from = a;
-    for (auto& [at, part] : chain) {
-      Node node;
-      node.position = at;
-      node.radius = surface.radius(at, part);
-      const auto id = static_cast<std::uint32_t>(sk.nodes.size());
-      for (std::uint32_t k : part) node_of_vertex[k] = id, moved[k] = 1;
-      node.vertices = std::move(part);
-      sk.nodes.push_back(std::move(node));
-      add_edge(from, id);
-      from = id;
-    }
-    add_edge(from, b);
-    }
-  };
-  if (options.section_nodes) add_sections(std::vector<std::array<std::uint32_t, 2>>(edges.begin(), edges.end()));
+  if (options.section_nodes)
+    add_sections(sk, edges, node_of_vertex, moved, surface, std::vector<std::array<std::uint32_t, 2>>(edges.begin(), edges.end()));
   if (options.unfold_branches) unfold_branches(sk, edges, surface);
   // Protrusions that the contraction merged whole (s11branch): a thin part (an ear, a foot, a
   // tusk) that contracted into a node of the body and whose vertices see that node, so the
@@ -1969,13 +1982,13 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
       for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
       const std::size_t count = sk.nodes.size();
-      for (auto leaf = static_cast<std::uint32_t>(first_new); leaf < count; ++leaf) extend_tip(leaf, adjacency);
+      for (auto leaf = static_cast<std::uint32_t>(first_new); leaf < count; ++leaf) extend_tip(sk, edges, node_of_vertex, surface, leaf, adjacency);
     }
     if (options.section_nodes) {
       std::vector<std::array<std::uint32_t, 2>> added;
       for (const auto& e : edges)
         if (e[1] >= first_new) added.push_back(e);
-      add_sections(added);
+      add_sections(sk, edges, node_of_vertex, moved, surface, added);
     }
   }
   // Sheet-triangle edges are part of the sheet, not curve edges.
