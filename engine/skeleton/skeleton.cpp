@@ -1227,6 +1227,106 @@ std::pair<glm::dmat3, glm::dvec3> covariance(const Points& points) {
   return {c / static_cast<double>(std::max<std::size_t>(1, points.size())), m};
 }
 
+// `region` split into pieces of connected vertices whose centre points share a cell of
+// kRegionCell * diag (in the order of their first vertex), and whether it is mostly flat:
+// flat pieces of >= 4 vertices hold over half of those pieces' vertices. A piece is flat when
+//   - its centre points spread in two directions (lambda_2 / lambda_1 > kFlatRatio), and
+//   - the region's centre points within twice the piece's thickness t of its mean spread in
+//     their second principal direction over more than t (sqrt(12 lambda_2), a uniform
+//     spread's length). That is "wider than thick": a plate's mid-surface fills the ball in
+//     two directions (a disc: 3.5 t across; at the plate's rim half a disc: 1.8 t), a limb's
+//     centre points lie along its axis (an elliptic limb's, along a segment that is longer
+//     than the limb is thick only where the section is over twice as wide as thick). The cell
+//     alone cannot say it: it caps the first spread at the cell, so a limb about as thick as
+//     the cell looks as round as a plate (the armadillo's forearm became a sheet). The thickness
+//     t is twice the mean distance from a vertex to its centre point (the SDF where the
+//     centre point came from it).
+struct Pieces {
+  std::vector<std::vector<std::uint32_t>> pieces;
+  bool mostly_flat = false;
+};
+
+// The grid cell of side `cell` that holds q.
+std::array<std::int64_t, 3> cell_key(const glm::dvec3& q, double cell) {
+  return std::array<std::int64_t, 3>{static_cast<std::int64_t>(std::floor(q.x / cell)),
+                                     static_cast<std::int64_t>(std::floor(q.y / cell)),
+                                     static_cast<std::int64_t>(std::floor(q.z / cell))};
+}
+
+Pieces split_region(const Surface& surface, const std::vector<std::uint32_t>& region) {
+  const Mesh& original = surface.original;
+  const double cell = kRegionCell * bounding_box(original.positions).diagonal();
+  std::map<std::array<std::int64_t, 3>, std::uint32_t> cell_index;
+  std::vector<std::uint32_t> cell_of(region.size());
+  std::map<std::uint32_t, std::uint32_t> slot;  // vertex -> index in region
+  for (std::uint32_t i = 0; i < region.size(); ++i) {
+    const std::array<std::int64_t, 3> key = cell_key(glm::dvec3(surface.centre[region[i]]), cell);
+    cell_of[i] = cell_index.try_emplace(key, static_cast<std::uint32_t>(cell_index.size())).first->second;
+    slot[region[i]] = i;
+  }
+  UnionFind pieces(region.size());
+  for (const Triangle& t : original.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const auto a = slot.find(t[e]), b = slot.find(t[(e + 1) % 3]);
+      if (a != slot.end() && b != slot.end() && cell_of[a->second] == cell_of[b->second])
+        pieces.unite(a->second, b->second);
+    }
+  std::map<std::uint32_t, std::vector<std::uint32_t>> piece_members;
+  std::vector<std::uint32_t> piece_order;
+  for (std::uint32_t i = 0; i < region.size(); ++i) {
+    auto [it, inserted] = piece_members.try_emplace(pieces.find(i));
+    if (inserted) piece_order.push_back(pieces.find(i));
+    it->second.push_back(region[i]);
+  }
+  // The region's centre points on a grid of the same cell, for the balls around the pieces.
+  std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> region_cells;
+  for (std::uint32_t k : region) region_cells[cell_key(glm::dvec3(surface.centre[k]), cell)].push_back(k);
+  double flat = 0.0, total = 0.0;
+  for (std::uint32_t r : piece_order) {
+    const std::vector<std::uint32_t>& piece = piece_members[r];
+    if (piece.size() < 4) continue;
+    total += static_cast<double>(piece.size());
+    std::vector<glm::dvec3> points;
+    double thickness = 0.0;
+    for (std::uint32_t k : piece) {
+      points.push_back(glm::dvec3(surface.centre[k]));
+      thickness += 2.0 * glm::length(glm::dvec3(original.positions[k]) - points.back());
+    }
+    thickness /= static_cast<double>(piece.size());
+    const std::pair<glm::dmat3, glm::dvec3> piece_cov = covariance(points);
+    const glm::dvec3 mean = piece_cov.second;  // a plain variable: lambdas below capture it
+    const std::array<double, 3> e = symmetric_eigenvalues(piece_cov.first);
+    if (!(e[0] > 0.0) || !(e[1] / e[0] > kFlatRatio)) continue;
+    const double reach = 2.0 * thickness;
+    points.clear();
+    const auto lo = cell_key(mean - glm::dvec3(reach), cell), hi = cell_key(mean + glm::dvec3(reach), cell);
+    const auto gather = [&](const std::vector<std::uint32_t>& members_of_cell) {
+      for (std::uint32_t k : members_of_cell)
+        if (glm::length(glm::dvec3(surface.centre[k]) - mean) <= reach) points.push_back(glm::dvec3(surface.centre[k]));
+    };
+    const double box_cells = static_cast<double>(hi[0] - lo[0] + 1) * static_cast<double>(hi[1] - lo[1] + 1) *
+                             static_cast<double>(hi[2] - lo[2] + 1);
+    if (box_cells > static_cast<double>(region_cells.size())) {
+      // A ball wider than the region's cells (a thick part): visit the occupied cells instead.
+      for (const auto& [key, members_of_cell] : region_cells)
+        if (key[0] >= lo[0] && key[0] <= hi[0] && key[1] >= lo[1] && key[1] <= hi[1] && key[2] >= lo[2] && key[2] <= hi[2])
+          gather(members_of_cell);
+    } else {
+      for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+            if (const auto it = region_cells.find({x, y, z}); it != region_cells.end()) gather(it->second);
+    }
+    if (points.size() < 4) continue;
+    const double spread = std::sqrt(12.0 * std::max(0.0, symmetric_eigenvalues(covariance(points).first)[1]));
+    if (spread > thickness) flat += static_cast<double>(piece.size());
+  }
+  Pieces out;
+  for (std::uint32_t r : piece_order) out.pieces.push_back(std::move(piece_members[r]));
+  out.mostly_flat = total > 0.0 && flat > 0.5 * total;
+  return out;
+}
+
 void validate(const SkeletonOptions& o) {
   if (!(o.ggt >= 0.0 && o.ggt < 1.0)) throw InputError("skeleton option ggt must be in [0, 1)");
   if (!(o.sheet_spacing >= 0.0 && o.sheet_spacing < 1.0))
@@ -1440,101 +1540,6 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     for (std::uint32_t k : seeing) choice[k] = c;
     return true;
   };
-  // `region` split into pieces of connected vertices whose centre points share a cell of
-  // kRegionCell * diag (in the order of their first vertex), and whether it is mostly flat:
-  // flat pieces of >= 4 vertices hold over half of those pieces' vertices. A piece is flat when
-  //   - its centre points spread in two directions (lambda_2 / lambda_1 > kFlatRatio), and
-  //   - the region's centre points within twice the piece's thickness t of its mean spread in
-  //     their second principal direction over more than t (sqrt(12 lambda_2), a uniform
-  //     spread's length). That is "wider than thick": a plate's mid-surface fills the ball in
-  //     two directions (a disc: 3.5 t across; at the plate's rim half a disc: 1.8 t), a limb's
-  //     centre points lie along its axis (an elliptic limb's, along a segment that is longer
-  //     than the limb is thick only where the section is over twice as wide as thick). The cell
-  //     alone cannot say it: it caps the first spread at the cell, so a limb about as thick as
-  //     the cell looks as round as a plate (the armadillo's forearm became a sheet). The thickness
-  //     t is twice the mean distance from a vertex to its centre point (the SDF where the
-  //     centre point came from it).
-  struct Pieces {
-    std::vector<std::vector<std::uint32_t>> pieces;
-    bool mostly_flat = false;
-  };
-  auto cell_key = [](const glm::dvec3& q, double cell) {
-    return std::array<std::int64_t, 3>{static_cast<std::int64_t>(std::floor(q.x / cell)),
-                                       static_cast<std::int64_t>(std::floor(q.y / cell)),
-                                       static_cast<std::int64_t>(std::floor(q.z / cell))};
-  };
-  auto split_region = [&](const std::vector<std::uint32_t>& region) {
-    const double cell = kRegionCell * diag;
-    std::map<std::array<std::int64_t, 3>, std::uint32_t> cell_index;
-    std::vector<std::uint32_t> cell_of(region.size());
-    std::map<std::uint32_t, std::uint32_t> slot;  // vertex -> index in region
-    for (std::uint32_t i = 0; i < region.size(); ++i) {
-      const std::array<std::int64_t, 3> key = cell_key(glm::dvec3(surface.centre[region[i]]), cell);
-      cell_of[i] = cell_index.try_emplace(key, static_cast<std::uint32_t>(cell_index.size())).first->second;
-      slot[region[i]] = i;
-    }
-    UnionFind pieces(region.size());
-    for (const Triangle& t : original.triangles)
-      for (int e = 0; e < 3; ++e) {
-        const auto a = slot.find(t[e]), b = slot.find(t[(e + 1) % 3]);
-        if (a != slot.end() && b != slot.end() && cell_of[a->second] == cell_of[b->second])
-          pieces.unite(a->second, b->second);
-      }
-    std::map<std::uint32_t, std::vector<std::uint32_t>> piece_members;
-    std::vector<std::uint32_t> piece_order;
-    for (std::uint32_t i = 0; i < region.size(); ++i) {
-      auto [it, inserted] = piece_members.try_emplace(pieces.find(i));
-      if (inserted) piece_order.push_back(pieces.find(i));
-      it->second.push_back(region[i]);
-    }
-    // The region's centre points on a grid of the same cell, for the balls around the pieces.
-    std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> region_cells;
-    for (std::uint32_t k : region) region_cells[cell_key(glm::dvec3(surface.centre[k]), cell)].push_back(k);
-    double flat = 0.0, total = 0.0;
-    for (std::uint32_t r : piece_order) {
-      const std::vector<std::uint32_t>& piece = piece_members[r];
-      if (piece.size() < 4) continue;
-      total += static_cast<double>(piece.size());
-      std::vector<glm::dvec3> points;
-      double thickness = 0.0;
-      for (std::uint32_t k : piece) {
-        points.push_back(glm::dvec3(surface.centre[k]));
-        thickness += 2.0 * glm::length(glm::dvec3(original.positions[k]) - points.back());
-      }
-      thickness /= static_cast<double>(piece.size());
-      const std::pair<glm::dmat3, glm::dvec3> piece_cov = covariance(points);
-      const glm::dvec3 mean = piece_cov.second;  // a plain variable: lambdas below capture it
-      const std::array<double, 3> e = symmetric_eigenvalues(piece_cov.first);
-      if (!(e[0] > 0.0) || !(e[1] / e[0] > kFlatRatio)) continue;
-      const double reach = 2.0 * thickness;
-      points.clear();
-      const auto lo = cell_key(mean - glm::dvec3(reach), cell), hi = cell_key(mean + glm::dvec3(reach), cell);
-      const auto gather = [&](const std::vector<std::uint32_t>& members_of_cell) {
-        for (std::uint32_t k : members_of_cell)
-          if (glm::length(glm::dvec3(surface.centre[k]) - mean) <= reach) points.push_back(glm::dvec3(surface.centre[k]));
-      };
-      const double box_cells = static_cast<double>(hi[0] - lo[0] + 1) * static_cast<double>(hi[1] - lo[1] + 1) *
-                               static_cast<double>(hi[2] - lo[2] + 1);
-      if (box_cells > static_cast<double>(region_cells.size())) {
-        // A ball wider than the region's cells (a thick part): visit the occupied cells instead.
-        for (const auto& [key, members_of_cell] : region_cells)
-          if (key[0] >= lo[0] && key[0] <= hi[0] && key[1] >= lo[1] && key[1] <= hi[1] && key[2] >= lo[2] && key[2] <= hi[2])
-            gather(members_of_cell);
-      } else {
-        for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-          for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-            for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
-              if (const auto it = region_cells.find({x, y, z}); it != region_cells.end()) gather(it->second);
-      }
-      if (points.size() < 4) continue;
-      const double spread = std::sqrt(12.0 * std::max(0.0, symmetric_eigenvalues(covariance(points).first)[1]));
-      if (spread > thickness) flat += static_cast<double>(piece.size());
-    }
-    Pieces out;
-    for (std::uint32_t r : piece_order) out.pieces.push_back(std::move(piece_members[r]));
-    out.mostly_flat = total > 0.0 && flat > 0.5 * total;
-    return out;
-  };
   // A node for each piece (add_node), the pieces nearest to the existing skeleton first, so a
   // missed limb becomes a chain of nodes; true when any was added.
   auto add_piece_nodes = [&](const Pieces& split) {
@@ -1578,7 +1583,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       // spread is small), across a plate with a non-convex cross-section they fill the cell.
       // A region whose pieces are mostly flat is a sheet; otherwise each piece gets a node,
       // nearest to the existing skeleton first, so a missed limb becomes a chain of nodes.
-      const Pieces split = split_region(region);
+      const Pieces split = split_region(surface, region);
       if (split.mostly_flat && static_cast<double>(region.size()) >= kSheetRegionShare * static_cast<double>(n)) {
         for (std::uint32_t k : region) region_is_sheet[k] = 1;
         continue;
@@ -1964,7 +1969,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
           any = true;
           continue;
         }
-        const Pieces split = split_region(region);
+        const Pieces split = split_region(surface, region);
         if (split.mostly_flat) continue;
         std::vector<std::pair<float, std::uint32_t>> order;
         for (std::uint32_t i = 0; i < split.pieces.size(); ++i) {
