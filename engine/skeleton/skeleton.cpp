@@ -1327,6 +1327,209 @@ Pieces split_region(const Surface& surface, const std::vector<std::uint32_t>& re
   return out;
 }
 
+// Protrusions that the contraction merged whole (s11branch): a thin part (an ear, a foot, a
+// tusk) that contracted into a node of the body and whose vertices see that node, so the
+// regions above (vertices that see no curve node) never gave it a branch. The skeleton stands
+// for the union of its curve nodes' balls (position, radius) swept along its curve edges
+// (radius interpolated along the edge), the union the pruning of terminal branches asks about.
+// A vertex whose centre point lies outside that union lies on a part of the solid that the
+// skeleton does not reach. A connected region of such vertices is a protrusion when
+//   - it reaches farther from its base (the vertices just outside the region: the distance
+//     from its farthest vertex to the nearest base vertex) than the base's own radius (from
+//     the base's centroid): a bump on its base reaches at most a hemisphere, a band along a
+//     flattened body or a plate's rim is as wide along its boundary as it is far from it.
+//     Measured from the base's centroid instead, the end band of a thin-walled pipe passed
+//     (its base circles the axis and the centroid lies on the axis);
+//   - the ball of the region (mean centre point, mean vertex radius |u - centre| = SDF/2)
+//     does not touch the union either (a band beside a spine has its mean near the spine);
+//   - its base has no sheet vertex (a region beside a sheet continues that plate: the C plate).
+// It gets curve nodes by the rules of the unseen regions: one node at the mean of its centre
+// points when at least half of its vertices see it, joined to the nearest curve node it sees
+// through the solid; else one per piece unless the pieces are mostly flat. A vertex moves to
+// the new node when it sees it and its node keeps another vertex; a region that gets no node
+// stays as it is. Up to three rounds (the union grows with the new nodes); then the new leaves
+// get their tip nodes as above. Every new node is inside and every new edge is a segment
+// inside from a new leaf to the skeleton, so cycles and sheets are unchanged. This runs after
+// the cross-section nodes, so a branch joins the curve near where the protrusion leaves it (a
+// heel joins the ankle's section, not the foot's leaf, which homer's foot lost otherwise),
+// and the new edges get their own cross-sections. No new constant.
+void add_protrusion_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_of_vertex,
+                             std::vector<std::uint8_t>& moved, const Surface& surface, const SkeletonOptions& options) {
+  const Mesh& original = surface.original;
+  const std::size_t n = original.positions.size();
+  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
+    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
+  };
+  const std::size_t first_new = sk.nodes.size();
+  // Mesh neighbours of each vertex (CSR).
+  std::vector<std::uint32_t> ring_start(n + 1, 0), ring;
+  {
+    std::vector<std::array<std::uint32_t, 2>> pairs;
+    for (const Triangle& t : original.triangles)
+      for (int i = 0; i < 3; ++i) pairs.push_back({t[i], t[(i + 1) % 3]}), pairs.push_back({t[(i + 1) % 3], t[i]});
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    for (const auto& pr : pairs) ++ring_start[pr[0] + 1];
+    for (std::size_t k = 0; k < n; ++k) ring_start[k + 1] += ring_start[k];
+    ring.reserve(pairs.size());
+    for (const auto& pr : pairs) ring.push_back(pr[1]);
+  }
+  std::vector<float> vertex_radius(n);
+  for (std::uint32_t k = 0; k < n; ++k)
+    vertex_radius[k] = glm::length(original.positions[k] - surface.centre[k]);
+  for (int round = 0; round < 3; ++round) {
+    std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+    std::vector<std::array<std::uint32_t, 2>> curve_edges;
+    for (const auto& e : edges) {
+      adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+      if (!sk.nodes[e[0]].sheet && !sk.nodes[e[1]].sheet) curve_edges.push_back(e);
+    }
+    auto touches_edge = [&](const glm::vec3& p, float r, std::uint32_t a, std::uint32_t b) {
+      return outside_swept_ball(p, sk.nodes[a], sk.nodes[b]) <= r;
+    };
+    // Does the ball (p, r) touch the skeleton's union? `hint`'s node and edges first.
+    auto touches = [&](const glm::vec3& p, float r, std::uint32_t hint) {
+      if (hint != UINT32_MAX) {
+        if (glm::length(p - sk.nodes[hint].position) <= sk.nodes[hint].radius + r) return true;
+        for (std::uint32_t d : adjacency[hint])
+          if (!sk.nodes[d].sheet && touches_edge(p, r, hint, d)) return true;
+      }
+      for (const Node& node : sk.nodes)
+        if (!node.sheet && glm::length(p - node.position) <= node.radius + r) return true;
+      for (const auto& e : curve_edges)
+        if (touches_edge(p, r, e[0], e[1])) return true;
+      return false;
+    };
+    std::vector<std::uint32_t> stamp(n, 0);  // boundary vertices seen, per region (root + 1)
+    std::vector<std::uint8_t> outside(n, 0);
+    parallel_for(n, [&](std::size_t begin, std::size_t end) {
+      for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
+        const std::uint32_t c = node_of_vertex[k];
+        outside[k] = c != UINT32_MAX && !sk.nodes[c].sheet && !touches(surface.centre[k], 0.0f, c);
+      }
+    });
+    UnionFind regions(n);
+    for (const Triangle& t : original.triangles)
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+        if (outside[a] && outside[b]) regions.unite(a, b);
+      }
+    std::map<std::uint32_t, std::vector<std::uint32_t>> region_members;  // root -> vertices (ascending)
+    std::vector<std::uint32_t> region_order;
+    for (std::uint32_t k = 0; k < n; ++k)
+      if (outside[k]) {
+        auto [it, inserted] = region_members.try_emplace(regions.find(k));
+        if (inserted) region_order.push_back(regions.find(k));
+        it->second.push_back(k);
+      }
+    // A new curve leaf for `part` (the region step's add_node on the skeleton's nodes).
+    auto add_leaf = [&](const std::vector<std::uint32_t>& part) {
+      std::optional<Surface::RegionNode> found = surface.region_node(part);
+      if (!found) return false;
+      const glm::vec3 p = found->point;
+      std::vector<std::uint32_t>& seeing = found->seeing;
+      std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
+      for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
+        if (!sk.nodes[c].sheet) curve.push_back({c, sk.nodes[c].position});
+      const std::uint32_t attach = surface.nearest_seen_node(p, curve);
+      if (attach == UINT32_MAX) return false;
+      // Each node keeps a vertex: where all of a node's vertices would move, the one nearest
+      // to it stays.
+      std::map<std::uint32_t, std::size_t> leaving;
+      for (std::uint32_t k : seeing) ++leaving[node_of_vertex[k]];
+      for (const auto& [c, count] : leaving) {
+        if (count < sk.nodes[c].vertices.size()) continue;
+        std::uint32_t stay = sk.nodes[c].vertices.front();
+        for (std::uint32_t k : sk.nodes[c].vertices)
+          if (glm::length(original.positions[k] - sk.nodes[c].position) <
+              glm::length(original.positions[stay] - sk.nodes[c].position))
+            stay = k;
+        std::erase(seeing, stay);
+      }
+      if (seeing.empty()) return false;
+      const auto id = static_cast<std::uint32_t>(sk.nodes.size());
+      for (const auto& [c, count] : leaving)
+        std::erase_if(sk.nodes[c].vertices, [&](std::uint32_t k) {
+          return std::binary_search(seeing.begin(), seeing.end(), k);
+        });
+      for (std::uint32_t k : seeing) node_of_vertex[k] = id;
+      Node node;
+      node.position = p;
+      node.radius = surface.radius(p, seeing);
+      node.vertices = std::move(seeing);
+      sk.nodes.push_back(std::move(node));
+      add_edge(attach, id);
+      return true;
+    };
+    bool any = false;
+    for (std::uint32_t root : region_order) {
+      const std::vector<std::uint32_t>& region = region_members[root];
+      glm::dvec3 mean(0.0);
+      double r = 0.0;
+      for (std::uint32_t k : region) mean += glm::dvec3(surface.centre[k]), r += vertex_radius[k];
+      const double count = static_cast<double>(region.size());
+      if (touches(glm::vec3(mean / count), static_cast<float>(r / count), UINT32_MAX)) continue;
+      // A limb reaches farther from where it leaves the rest of the surface (its base) than
+      // the base's radius; a bump reaches at most a hemisphere, and a band along a flattened
+      // body or a plate's rim is as wide along its base as it is far from it.
+      // A region that borders a sheet continues the plate that the sheet describes (the C
+      // plate's ends), not a limb.
+      glm::dvec3 base(0.0);
+      std::vector<std::uint32_t> boundary;
+      bool borders_sheet = false;
+      for (std::uint32_t k : region)
+        for (std::uint32_t i = ring_start[k]; i < ring_start[k + 1]; ++i) {
+          const std::uint32_t w = ring[i];
+          if (outside[w] || stamp[w] == root + 1) continue;
+          stamp[w] = root + 1;
+          boundary.push_back(w);
+          base += glm::dvec3(original.positions[w]);
+          borders_sheet = borders_sheet || node_of_vertex[w] == UINT32_MAX || sk.nodes[node_of_vertex[w]].sheet;
+        }
+      if (boundary.empty() || borders_sheet) continue;
+      base /= static_cast<double>(boundary.size());
+      double base_radius = 0.0, reach = 0.0;
+      for (std::uint32_t w : boundary)
+        base_radius = std::max(base_radius, glm::length(glm::dvec3(original.positions[w]) - base));
+      for (std::uint32_t k : region) {
+        double nearest = std::numeric_limits<double>::infinity();
+        for (std::uint32_t w : boundary)
+          nearest = std::min(nearest, glm::length(glm::dvec3(original.positions[k]) - glm::dvec3(original.positions[w])));
+        reach = std::max(reach, nearest);
+      }
+      if (!(reach > base_radius)) continue;
+      if (add_leaf(region)) {
+        any = true;
+        continue;
+      }
+      const Pieces split = split_region(surface, region);
+      if (split.mostly_flat) continue;
+      std::vector<std::pair<float, std::uint32_t>> order;
+      for (std::uint32_t i = 0; i < split.pieces.size(); ++i) {
+        float best = std::numeric_limits<float>::max();
+        for (const Node& node : sk.nodes)
+          if (!node.sheet) best = std::min(best, glm::length(node.position - surface.centre[split.pieces[i].front()]));
+        order.push_back({best, i});
+      }
+      std::sort(order.begin(), order.end());
+      for (const auto& [d, i] : order) any |= add_leaf(split.pieces[i]);
+    }
+    if (!any) break;
+  }
+  if (options.extend_leaves && sk.nodes.size() > first_new) {
+    std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
+    for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+    const std::size_t count = sk.nodes.size();
+    for (auto leaf = static_cast<std::uint32_t>(first_new); leaf < count; ++leaf) extend_tip(sk, edges, node_of_vertex, surface, leaf, adjacency);
+  }
+  if (options.section_nodes) {
+    std::vector<std::array<std::uint32_t, 2>> added;
+    for (const auto& e : edges)
+      if (e[1] >= first_new) added.push_back(e);
+    add_sections(sk, edges, node_of_vertex, moved, surface, added);
+  }
+}
+
 void validate(const SkeletonOptions& o) {
   if (!(o.ggt >= 0.0 && o.ggt < 1.0)) throw InputError("skeleton option ggt must be in [0, 1)");
   if (!(o.sheet_spacing >= 0.0 && o.sheet_spacing < 1.0))
@@ -1800,202 +2003,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   if (options.section_nodes)
     add_sections(sk, edges, node_of_vertex, moved, surface, std::vector<std::array<std::uint32_t, 2>>(edges.begin(), edges.end()));
   if (options.unfold_branches) unfold_branches(sk, edges, surface);
-  // Protrusions that the contraction merged whole (s11branch): a thin part (an ear, a foot, a
-  // tusk) that contracted into a node of the body and whose vertices see that node, so the
-  // regions above (vertices that see no curve node) never gave it a branch. The skeleton stands
-  // for the union of its curve nodes' balls (position, radius) swept along its curve edges
-  // (radius interpolated along the edge), the union the pruning of terminal branches asks about.
-  // A vertex whose centre point lies outside that union lies on a part of the solid that the
-  // skeleton does not reach. A connected region of such vertices is a protrusion when
-  //   - it reaches farther from its base (the vertices just outside the region: the distance
-  //     from its farthest vertex to the nearest base vertex) than the base's own radius (from
-  //     the base's centroid): a bump on its base reaches at most a hemisphere, a band along a
-  //     flattened body or a plate's rim is as wide along its boundary as it is far from it.
-  //     Measured from the base's centroid instead, the end band of a thin-walled pipe passed
-  //     (its base circles the axis and the centroid lies on the axis);
-  //   - the ball of the region (mean centre point, mean vertex radius |u - centre| = SDF/2)
-  //     does not touch the union either (a band beside a spine has its mean near the spine);
-  //   - its base has no sheet vertex (a region beside a sheet continues that plate: the C plate).
-  // It gets curve nodes by the rules of the unseen regions: one node at the mean of its centre
-  // points when at least half of its vertices see it, joined to the nearest curve node it sees
-  // through the solid; else one per piece unless the pieces are mostly flat. A vertex moves to
-  // the new node when it sees it and its node keeps another vertex; a region that gets no node
-  // stays as it is. Up to three rounds (the union grows with the new nodes); then the new leaves
-  // get their tip nodes as above. Every new node is inside and every new edge is a segment
-  // inside from a new leaf to the skeleton, so cycles and sheets are unchanged. This runs after
-  // the cross-section nodes, so a branch joins the curve near where the protrusion leaves it (a
-  // heel joins the ankle's section, not the foot's leaf, which homer's foot lost otherwise),
-  // and the new edges get their own cross-sections. No new constant.
-  if (options.protrusion_branches) {
-    const std::size_t first_new = sk.nodes.size();
-    // Mesh neighbours of each vertex (CSR).
-    std::vector<std::uint32_t> ring_start(n + 1, 0), ring;
-    {
-      std::vector<std::array<std::uint32_t, 2>> pairs;
-      for (const Triangle& t : original.triangles)
-        for (int i = 0; i < 3; ++i) pairs.push_back({t[i], t[(i + 1) % 3]}), pairs.push_back({t[(i + 1) % 3], t[i]});
-      std::sort(pairs.begin(), pairs.end());
-      pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-      for (const auto& pr : pairs) ++ring_start[pr[0] + 1];
-      for (std::size_t k = 0; k < n; ++k) ring_start[k + 1] += ring_start[k];
-      ring.reserve(pairs.size());
-      for (const auto& pr : pairs) ring.push_back(pr[1]);
-    }
-    std::vector<float> vertex_radius(n);
-    for (std::uint32_t k = 0; k < n; ++k)
-      vertex_radius[k] = glm::length(original.positions[k] - surface.centre[k]);
-    for (int round = 0; round < 3; ++round) {
-      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
-      std::vector<std::array<std::uint32_t, 2>> curve_edges;
-      for (const auto& e : edges) {
-        adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
-        if (!sk.nodes[e[0]].sheet && !sk.nodes[e[1]].sheet) curve_edges.push_back(e);
-      }
-      auto touches_edge = [&](const glm::vec3& p, float r, std::uint32_t a, std::uint32_t b) {
-        return outside_swept_ball(p, sk.nodes[a], sk.nodes[b]) <= r;
-      };
-      // Does the ball (p, r) touch the skeleton's union? `hint`'s node and edges first.
-      auto touches = [&](const glm::vec3& p, float r, std::uint32_t hint) {
-        if (hint != UINT32_MAX) {
-          if (glm::length(p - sk.nodes[hint].position) <= sk.nodes[hint].radius + r) return true;
-          for (std::uint32_t d : adjacency[hint])
-            if (!sk.nodes[d].sheet && touches_edge(p, r, hint, d)) return true;
-        }
-        for (const Node& node : sk.nodes)
-          if (!node.sheet && glm::length(p - node.position) <= node.radius + r) return true;
-        for (const auto& e : curve_edges)
-          if (touches_edge(p, r, e[0], e[1])) return true;
-        return false;
-      };
-      std::vector<std::uint32_t> stamp(n, 0);  // boundary vertices seen, per region (root + 1)
-      std::vector<std::uint8_t> outside(n, 0);
-      parallel_for(n, [&](std::size_t begin, std::size_t end) {
-        for (auto k = static_cast<std::uint32_t>(begin); k < end; ++k) {
-          const std::uint32_t c = node_of_vertex[k];
-          outside[k] = c != UINT32_MAX && !sk.nodes[c].sheet && !touches(surface.centre[k], 0.0f, c);
-        }
-      });
-      UnionFind regions(n);
-      for (const Triangle& t : original.triangles)
-        for (int i = 0; i < 3; ++i) {
-          const std::uint32_t a = t[i], b = t[(i + 1) % 3];
-          if (outside[a] && outside[b]) regions.unite(a, b);
-        }
-      std::map<std::uint32_t, std::vector<std::uint32_t>> region_members;  // root -> vertices (ascending)
-      std::vector<std::uint32_t> region_order;
-      for (std::uint32_t k = 0; k < n; ++k)
-        if (outside[k]) {
-          auto [it, inserted] = region_members.try_emplace(regions.find(k));
-          if (inserted) region_order.push_back(regions.find(k));
-          it->second.push_back(k);
-        }
-      // A new curve leaf for `part` (the region step's add_node on the skeleton's nodes).
-      auto add_leaf = [&](const std::vector<std::uint32_t>& part) {
-        std::optional<Surface::RegionNode> found = surface.region_node(part);
-        if (!found) return false;
-        const glm::vec3 p = found->point;
-        std::vector<std::uint32_t>& seeing = found->seeing;
-        std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
-        for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
-          if (!sk.nodes[c].sheet) curve.push_back({c, sk.nodes[c].position});
-        const std::uint32_t attach = surface.nearest_seen_node(p, curve);
-        if (attach == UINT32_MAX) return false;
-        // Each node keeps a vertex: where all of a node's vertices would move, the one nearest
-        // to it stays.
-        std::map<std::uint32_t, std::size_t> leaving;
-        for (std::uint32_t k : seeing) ++leaving[node_of_vertex[k]];
-        for (const auto& [c, count] : leaving) {
-          if (count < sk.nodes[c].vertices.size()) continue;
-          std::uint32_t stay = sk.nodes[c].vertices.front();
-          for (std::uint32_t k : sk.nodes[c].vertices)
-            if (glm::length(original.positions[k] - sk.nodes[c].position) <
-                glm::length(original.positions[stay] - sk.nodes[c].position))
-              stay = k;
-          std::erase(seeing, stay);
-        }
-        if (seeing.empty()) return false;
-        const auto id = static_cast<std::uint32_t>(sk.nodes.size());
-        for (const auto& [c, count] : leaving)
-          std::erase_if(sk.nodes[c].vertices, [&](std::uint32_t k) {
-            return std::binary_search(seeing.begin(), seeing.end(), k);
-          });
-        for (std::uint32_t k : seeing) node_of_vertex[k] = id;
-        Node node;
-        node.position = p;
-        node.radius = surface.radius(p, seeing);
-        node.vertices = std::move(seeing);
-        sk.nodes.push_back(std::move(node));
-        add_edge(attach, id);
-        return true;
-      };
-      bool any = false;
-      for (std::uint32_t root : region_order) {
-        const std::vector<std::uint32_t>& region = region_members[root];
-        glm::dvec3 mean(0.0);
-        double r = 0.0;
-        for (std::uint32_t k : region) mean += glm::dvec3(surface.centre[k]), r += vertex_radius[k];
-        const double count = static_cast<double>(region.size());
-        if (touches(glm::vec3(mean / count), static_cast<float>(r / count), UINT32_MAX)) continue;
-        // A limb reaches farther from where it leaves the rest of the surface (its base) than
-        // the base's radius; a bump reaches at most a hemisphere, and a band along a flattened
-        // body or a plate's rim is as wide along its base as it is far from it.
-        // A region that borders a sheet continues the plate that the sheet describes (the C
-        // plate's ends), not a limb.
-        glm::dvec3 base(0.0);
-        std::vector<std::uint32_t> boundary;
-        bool borders_sheet = false;
-        for (std::uint32_t k : region)
-          for (std::uint32_t i = ring_start[k]; i < ring_start[k + 1]; ++i) {
-            const std::uint32_t w = ring[i];
-            if (outside[w] || stamp[w] == root + 1) continue;
-            stamp[w] = root + 1;
-            boundary.push_back(w);
-            base += glm::dvec3(original.positions[w]);
-            borders_sheet = borders_sheet || node_of_vertex[w] == UINT32_MAX || sk.nodes[node_of_vertex[w]].sheet;
-          }
-        if (boundary.empty() || borders_sheet) continue;
-        base /= static_cast<double>(boundary.size());
-        double base_radius = 0.0, reach = 0.0;
-        for (std::uint32_t w : boundary)
-          base_radius = std::max(base_radius, glm::length(glm::dvec3(original.positions[w]) - base));
-        for (std::uint32_t k : region) {
-          double nearest = std::numeric_limits<double>::infinity();
-          for (std::uint32_t w : boundary)
-            nearest = std::min(nearest, glm::length(glm::dvec3(original.positions[k]) - glm::dvec3(original.positions[w])));
-          reach = std::max(reach, nearest);
-        }
-        if (!(reach > base_radius)) continue;
-        if (add_leaf(region)) {
-          any = true;
-          continue;
-        }
-        const Pieces split = split_region(surface, region);
-        if (split.mostly_flat) continue;
-        std::vector<std::pair<float, std::uint32_t>> order;
-        for (std::uint32_t i = 0; i < split.pieces.size(); ++i) {
-          float best = std::numeric_limits<float>::max();
-          for (const Node& node : sk.nodes)
-            if (!node.sheet) best = std::min(best, glm::length(node.position - surface.centre[split.pieces[i].front()]));
-          order.push_back({best, i});
-        }
-        std::sort(order.begin(), order.end());
-        for (const auto& [d, i] : order) any |= add_leaf(split.pieces[i]);
-      }
-      if (!any) break;
-    }
-    if (options.extend_leaves && sk.nodes.size() > first_new) {
-      std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
-      for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
-      const std::size_t count = sk.nodes.size();
-      for (auto leaf = static_cast<std::uint32_t>(first_new); leaf < count; ++leaf) extend_tip(sk, edges, node_of_vertex, surface, leaf, adjacency);
-    }
-    if (options.section_nodes) {
-      std::vector<std::array<std::uint32_t, 2>> added;
-      for (const auto& e : edges)
-        if (e[1] >= first_new) added.push_back(e);
-      add_sections(sk, edges, node_of_vertex, moved, surface, added);
-    }
-  }
+  if (options.protrusion_branches) add_protrusion_branches(sk, edges, node_of_vertex, moved, surface, options);
   // Sheet-triangle edges are part of the sheet, not curve edges.
   std::set<std::array<std::uint32_t, 2>> sheet_edges;
   for (const Triangle& t : sk.sheet_triangles)
