@@ -1079,33 +1079,47 @@ void prune_covered_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint3
     edges = renumbered(edges, remove_nodes(sk, dead, node_of_vertex));
 }
 
-// Terminal branches that fold. A leg that contracted to a flat ribbon collapses to its two
-// rims, joined at the hoof; placed at their vertices' centre points the rims fall onto one
-// line, and with the loop cut at the top the leg's chain runs down to the hoof and back up,
-// its leaf at mid-leg (CGAL's cow and bull). A branch (a leaf and its chain of degree-2 curve
-// nodes up to the first node of another degree) folds where a run of its nodes from the leaf
-// lies beside the rest of the branch. A node x lies beside an edge of the rest when it
-// projects strictly between the edge's ends, its centre is inside the balls swept along the
-// edge, and the edge passes through x's own ball: both ways, since a thin foot bent back along
-// a thick leg lies in the leg's balls but the leg's axis is not in the foot's (triceratops).
-// A node that coincides with an inner node of the rest (each inside the other's ball, that
-// node the rest's nearest) lies beside it too. The longest such run is threaded into the
-// rest, each node into the edge it lies deepest in (outside_swept_ball over the radius there)
-// in the order they project onto it, so the node where the branch turned becomes the leaf.
-// Along an unfolded chain a node lies past the end of the next edge, never strictly beside
-// it (a tube's axis cannot bend tighter than its radius), so a limb's own tip stays: the
-// rest's first node has no edge beyond it. Nodes and edges keep their counts, so the cycles
-// do. The new chain must be shorter than the branch was (so no two nodes trade places back
-// and forth) and stay inside, else the branch stays. Repeated while a branch changes (its new
-// leaf can start another run), each branch once per round. This runs after the cross-section
-// nodes: before them a limb's curve is a chord between grouped nodes, and the returning rim
-// lies off it near the hoof (the bull's folded leg then stayed), while earlier leaves moved
-// bunny00's ear branch 0.047 -> 0.086 of the diagonal from its tip.
+// Terminal branches that fold, or run beside another limb. A leg that contracted to a flat
+// ribbon collapses to its two rims, joined at the hoof; placed at their vertices' centre points
+// the rims fall onto one line, and with the loop cut at the top the leg's chain runs down to
+// the hoof and back up, its leaf at mid-leg (CGAL's cow and bull). A rim can also hang from a
+// junction beside its limb's chain as a strand of its own, a leaf in the middle of the limb
+// (the armadillo's legs). A branch (a leaf and its chain of degree-2 curve nodes up to the
+// first node of another degree) is unfolded where a run of its nodes from the leaf lies beside
+// the rest of the branch or beside another curve edge of its component (none with an end on
+// the branch before its last node). A node x lies beside an edge when it projects strictly
+// between the edge's ends, its centre is inside the balls swept along the edge, and the edge
+// passes through x's own ball: both ways, since a thin foot bent back along a thick leg lies in
+// the leg's balls but the leg's axis is not in the foot's (triceratops), and a toe beside a
+// foot is thinner than the foot. A node that coincides with an inner node of the rest of its
+// branch (each inside the other's ball, that node the rest's nearest) lies beside it too. The
+// longest such run is threaded into those edges, each node into the edge it lies deepest in
+// (outside_swept_ball over the radius there) in the order they project onto it: the node
+// where the branch turned becomes the leaf, and a strand that lies beside its limb all the way
+// to the junction goes into the limb, the junction losing that branch. Along one chain a node
+// lies past the end of the next edge, never strictly beside it (a tube's axis cannot bend
+// tighter than its radius), so a limb's own tip stays: the rest's first node has no edge
+// beyond it. Each node threaded takes away one edge of the branch and adds one, so the cycles
+// stay, and the nodes stay in their component. The new edges must be shorter than those they
+// replace (so no node is threaded back and forth) and stay inside, else the branch stays.
+// Repeated while a branch changes (its new leaf can start another run); within a round no node
+// is used twice. This runs after the cross-section nodes: before them a limb's curve is a
+// chord between grouped nodes, and the returning rim lies off it near the hoof (the bull's
+// folded leg then stayed), while earlier it moved bunny00's ear leaf 0.073 -> 0.086 of
+// the diagonal from its tip. Merging a strand's nodes into the limb's nearer nodes, instead of
+// threading them, gave cleaner chains but moved bunny00's ear leaf past the test's bound.
 void unfold_branches(Skeleton& sk, EdgeSet& edges, const Surface& surface) {
   std::size_t unfolded = 0;
   for (std::size_t round = 0; round < sk.nodes.size(); ++round) {
     std::vector<std::vector<std::uint32_t>> adjacency(sk.nodes.size());
-    for (const auto& e : edges) adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+    UnionFind parts(sk.nodes.size());
+    for (const auto& e : edges) {
+      adjacency[e[0]].push_back(e[1]), adjacency[e[1]].push_back(e[0]);
+      parts.unite(e[0], e[1]);
+    }
+    std::vector<std::array<std::uint32_t, 2>> curve_edges;
+    for (const auto& e : edges)
+      if (!sk.nodes[e[0]].sheet && !sk.nodes[e[1]].sheet) curve_edges.push_back(e);
     std::vector<std::uint8_t> touched(sk.nodes.size(), 0);
     bool changed = false;
     for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
@@ -1119,9 +1133,29 @@ void unfold_branches(Skeleton& sk, EdgeSet& edges, const Surface& surface) {
         prev = cur, cur = next;
       }
       full.push_back(cur);
-      if (sk.nodes[cur].sheet || touched[cur]) continue;
-      // Where node x lies deepest beside an edge of full[from..]: (edge's first index, t,
-      // depth), or index SIZE_MAX when beside none.
+      if (sk.nodes[cur].sheet || std::any_of(full.begin(), full.end(), [&](std::uint32_t x) { return touched[x]; }))
+        continue;
+      // The curve edges of the rest of the skeleton near the branch (none with an end on the
+      // branch before its last node), in the branch's component.
+      std::set<std::uint32_t> own(full.begin(), full.end() - 1);
+      glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+      float widest = 0.0f;
+      for (std::uint32_t x : full) {
+        lo = glm::min(lo, sk.nodes[x].position), hi = glm::max(hi, sk.nodes[x].position);
+        widest = std::max(widest, sk.nodes[x].radius);
+      }
+      std::vector<std::array<std::uint32_t, 2>> others;
+      for (const auto& e : curve_edges) {
+        if (own.count(e[0]) || own.count(e[1]) || touched[e[0]] || touched[e[1]] || parts.find(e[0]) != parts.find(cur))
+          continue;
+        const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
+        const float r = std::max(sk.nodes[e[0]].radius, sk.nodes[e[1]].radius) + widest;
+        if (glm::all(glm::lessThanEqual(glm::min(pa, pb) - r, hi)) && glm::all(glm::greaterThanEqual(glm::max(pa, pb) + r, lo)))
+          others.push_back(e);
+      }
+      // Where node x lies deepest beside an edge: (index: i for the branch's edge (full[i],
+      // full[i + 1]) with i >= from, full.size() + j for others[j]; t; depth), or index SIZE_MAX
+      // when beside none.
       struct Spot {
         std::size_t edge = SIZE_MAX;
         float t = 0.0f, depth = 0.0f;
@@ -1129,22 +1163,23 @@ void unfold_branches(Skeleton& sk, EdgeSet& edges, const Surface& surface) {
       auto beside = [&](std::uint32_t x, std::size_t from) {
         Spot best;
         const glm::vec3 p = sk.nodes[x].position;
-        for (std::size_t i = from; i + 1 < full.size(); ++i) {
-          const Node& a = sk.nodes[full[i]];
-          const Node& b = sk.nodes[full[i + 1]];
+        auto consider = [&](std::size_t index, const Node& a, const Node& b) {
           const float t = segment_parameter(p, a.position, b.position);
-          if (t <= 0.0f || t >= 1.0f) continue;
+          if (t <= 0.0f || t >= 1.0f) return;
           // Both ways: x's centre inside the balls swept along the edge, and the edge through
           // x's own ball (a thin foot bent back along a thick leg lies in the leg's balls, but
           // the leg's axis is not in the foot's).
           const float depth = std::max(outside_swept_ball(p, a, b) / (a.radius + t * (b.radius - a.radius)),
                                        distance_to_segment(p, a.position, b.position) / sk.nodes[x].radius - 1.0f);
-          if (depth < 0.0f && (best.edge == SIZE_MAX || depth < best.depth)) best = {i, t, depth};
-        }
-        // Or x coincides with an inner node y of the rest, the rest's node nearest to it
-        // (each inside the other's ball), where it projects onto neither of y's edges
-        // strictly: x goes next to y. (The rest's first node has no edge beyond it: a leaf
-        // past its neighbour, a limb's tip, is never beside.)
+          if (depth < 0.0f && (best.edge == SIZE_MAX || depth < best.depth)) best = {index, t, depth};
+        };
+        for (std::size_t i = from; i + 1 < full.size(); ++i) consider(i, sk.nodes[full[i]], sk.nodes[full[i + 1]]);
+        for (std::size_t j = 0; j < others.size(); ++j)
+          consider(full.size() + j, sk.nodes[others[j][0]], sk.nodes[others[j][1]]);
+        // Or x coincides with an inner node y of the rest of its branch, that branch's node
+        // nearest to it (each inside the other's ball), where it projects onto neither of y's
+        // edges strictly: x goes next to y. (The rest's first node has no edge beyond it: a
+        // leaf past its neighbour, a limb's tip, is never beside.)
         if (best.edge == SIZE_MAX) {
           std::size_t j = from;
           for (std::size_t i = from; i < full.size(); ++i)
@@ -1155,48 +1190,68 @@ void unfold_branches(Skeleton& sk, EdgeSet& edges, const Surface& surface) {
         }
         return best;
       };
-      // The longest run full[0..m) whose every node lies beside an edge of full[m..].
+      // The longest run full[0..m) whose every node lies beside an edge of full[m..] or of the
+      // rest of the skeleton; it may be the whole branch (a strand beside another limb, hanging
+      // from the junction), never the junction.
       std::size_t m = 0;
-      while (m + 2 < full.size()) {
+      while (m + 1 < full.size()) {
         bool all = true;
         for (std::size_t i = 0; i <= m && all; ++i) all = beside(full[i], m + 1).edge != SIZE_MAX;
         if (!all) break;
         ++m;
       }
       if (m == 0) continue;
-      std::vector<std::vector<std::pair<float, std::uint32_t>>> into(full.size());
+      std::vector<std::vector<std::pair<float, std::uint32_t>>> into(full.size() + others.size());
       for (std::size_t i = 0; i < m; ++i) {
         const Spot s = beside(full[i], m);
         into[s.edge].push_back({s.t, full[i]});
       }
-      std::vector<std::uint32_t> chain;
+      // The new chains: the rest of the branch with its own nodes threaded in, and each other
+      // edge that takes nodes.
+      std::vector<std::vector<std::uint32_t>> chains(1);
       for (std::size_t i = m; i < full.size(); ++i) {
-        chain.push_back(full[i]);
+        chains[0].push_back(full[i]);
         std::sort(into[i].begin(), into[i].end());
-        for (const auto& [t, x] : into[i]) chain.push_back(x);
+        for (const auto& [t, x] : into[i]) chains[0].push_back(x);
       }
-      // Shorter than the branch was (so no two nodes trade places back and forth), and inside.
+      std::vector<std::array<std::uint32_t, 2>> hosts;
+      for (std::size_t j = 0; j < others.size(); ++j) {
+        auto& in = into[full.size() + j];
+        if (in.empty()) continue;
+        std::sort(in.begin(), in.end());
+        hosts.push_back(others[j]);
+        chains.push_back({others[j][0]});
+        for (const auto& [t, x] : in) chains.back().push_back(x);
+        chains.back().push_back(others[j][1]);
+      }
+      // Shorter than what it replaces (so no two nodes trade places back and forth), and inside.
       auto length = [&](const std::vector<std::uint32_t>& path) {
         float sum = 0.0f;
         for (std::size_t i = 0; i + 1 < path.size(); ++i)
           sum += glm::length(sk.nodes[path[i]].position - sk.nodes[path[i + 1]].position);
         return sum;
       };
-      if (!(length(chain) < length(full))) continue;
+      float before = length(full), after = 0.0f;
+      for (const auto& h : hosts) before += length({h[0], h[1]});
+      for (const auto& c : chains) after += length(c);
+      if (!(after < before)) continue;
       bool inside = true;
-      for (std::size_t i = 0; i + 1 < chain.size() && inside; ++i)
-        inside = !surface.bvh.segment_blocked(sk.nodes[chain[i]].position, sk.nodes[chain[i + 1]].position);
+      for (const auto& c : chains)
+        for (std::size_t i = 0; i + 1 < c.size() && inside; ++i)
+          inside = !surface.bvh.segment_blocked(sk.nodes[c[i]].position, sk.nodes[c[i + 1]].position);
       if (!inside) continue;
       for (std::size_t i = 0; i + 1 < full.size(); ++i)
         edges.erase({std::min(full[i], full[i + 1]), std::max(full[i], full[i + 1])});
-      for (std::size_t i = 0; i + 1 < chain.size(); ++i) edges.insert({std::min(chain[i], chain[i + 1]), std::max(chain[i], chain[i + 1])});
+      for (const auto& h : hosts) edges.erase(h), touched[h[0]] = touched[h[1]] = 1;
+      for (const auto& c : chains)
+        for (std::size_t i = 0; i + 1 < c.size(); ++i) edges.insert({std::min(c[i], c[i + 1]), std::max(c[i], c[i + 1])});
       for (std::uint32_t x : full) touched[x] = 1;
       unfolded += m;
       changed = true;
     }
     if (!changed) break;
   }
-  log_debug("skeleton: " + std::to_string(unfolded) + " nodes of folded branches threaded back into their limb");
+  log_debug("skeleton: " + std::to_string(unfolded) + " nodes of branches threaded into the limb they lie beside");
 }
 
 // Eigenvalues of a symmetric positive semi-definite 3x3 matrix, largest first (trigonometric

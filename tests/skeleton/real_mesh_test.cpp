@@ -202,19 +202,24 @@ TEST(SkeletonRealMeshes, StraightLegEndsAtTheFootNotTheKnee) {
 // leaf is 0.136 of the diagonal from the ear's tip (the vertex extreme along (-1, 0, -1)) and
 // 0.274 from elk's lowest vertex (Embree; CGAL's skeleton has a leaf at each). A region of
 // vertices whose centre points lie outside the skeleton's balls, reaching farther from its base
-// than the base's radius, gets a branch with a leaf at its tip: 0.047 and 0.055, inside the
-// solid, cycles unchanged.
+// than the base's radius, gets a branch with a leaf at its tip: 0.047 and 0.055 when this test
+// was written, inside the solid, cycles unchanged. Later steps moved the ear's leaf: 0.073
+// before the twentieth session, 0.079 with the branches threaded into the limbs they lie
+// beside (the ear's branch wanders: its node nearest the tip, 0.036 away, is not its leaf);
+// the elk's 0.059. The bound is the test's since it was written.
 TEST(SkeletonRealMeshes, ProtrusionMergedIntoTheBodyGetsABranch) {
   {
     const Mesh mesh = load("bunny00.off");
     const sk::Skeleton s = extract(mesh);
     expect_valid(mesh, s, "bunny00.off");
+    std::printf("bunny00: ear tip to the nearest leaf %.4f of the diagonal\n", nearest_leaf(mesh, s, extreme(mesh, {-1, 0, -1})));
     EXPECT_LT(nearest_leaf(mesh, s, extreme(mesh, {-1, 0, -1})), 0.08) << "bunny00's ear";
   }
   {
     const Mesh mesh = load("elk.off");
     const sk::Skeleton s = extract(mesh);
     expect_valid(mesh, s, "elk.off");
+    std::printf("elk: hind foot to the nearest leaf %.4f of the diagonal\n", nearest_leaf(mesh, s, extreme(mesh, {0, 0, -1})));
     EXPECT_LT(nearest_leaf(mesh, s, extreme(mesh, {0, 0, -1})), 0.08) << "elk's hind foot";
   }
 }
@@ -564,8 +569,8 @@ std::size_t spur_branches(const sk::Skeleton& s) {
 // gets lies inside the limb's tube, and hung off the nearest node it sees it was a spur: on the
 // armadillo and the man most leaves were spurs whose curve never leaves the rest of the
 // skeleton (with Embree, as here: 52 of 72 and 27 of 49). Such a node now goes on the curve
-// edge whose swept ball holds it (20 of 43 and 7 of 30). Most leaves must reach out of the rest
-// of the skeleton; the armadillo is near that line, the spurs left come from other steps.
+// edge whose swept ball holds it (20 of 43 and 7 of 30; with the strands threaded into their
+// limbs, 9 of 32 and 2 of 25). Most leaves must reach out of the rest of the skeleton.
 TEST(SkeletonRealMeshes, MostLeavesReachOutOfTheRestOfTheSkeleton) {
   for (const char* name : {"armadillo.off", "man.off"}) {
     const sk::Skeleton s = extract(load(name));
@@ -623,6 +628,33 @@ TEST(SkeletonRealMeshes, TerminalBranchesEndWhereTheyTurn) {
     expect_valid(mesh, after, name);
   }
   EXPECT_GT(folded_before, 0u);
+}
+
+// A rim of a limb that contracted flat can hang from the junction as a strand of its own beside
+// the limb's chain, its leaf in the middle of the limb (the armadillo's legs). Its nodes lie
+// beside the limb's edges, so SkeletonOptions::unfold_branches threads them into the limb: with
+// Embree, the leaves whose branch never leaves the rest of the skeleton (spur_branches) fall
+// from 20 of 43 to 9 of 32 on the armadillo and from 7 of 30 to 2 of 25 on the man; the cycles
+// stay and every property of expect_valid holds.
+TEST(SkeletonRealMeshes, StrandsBesideALimbAreThreadedIntoIt) {
+  reference::EmbreeBackend backend;
+  sk::SkeletonOptions off;
+  off.unfold_branches = false;
+  for (const char* name : {"armadillo.off", "man.off"}) {
+    const Mesh mesh = load(name);
+    const sk::Skeleton before = sk::extract(mesh, &backend, {}, off);
+    const sk::Skeleton after = sk::extract(mesh, &backend, {}, {});
+    const auto leaves = [](const sk::Skeleton& s) {
+      const auto d = degrees(s);
+      return static_cast<std::size_t>(std::count(d.begin(), d.end(), 1));
+    };
+    std::printf("%s: spur leaves without unfolding %zu of %zu, with %zu of %zu\n", name, spur_branches(before),
+                leaves(before), spur_branches(after), leaves(after));
+    EXPECT_LT(spur_branches(after), spur_branches(before)) << name;
+    EXPECT_LT(leaves(after), leaves(before)) << name;
+    EXPECT_EQ(sk::cycle_count(after), sk::cycle_count(before)) << name;
+    expect_valid(mesh, after, name);
+  }
 }
 
 // A limb about as thick as the cell that the sheet test groups centre points in is a curve,

@@ -161,9 +161,10 @@ struct SkeletonOptions {
   // node it hangs from.
   bool prune_branches = true;
   // Unfold a terminal curve branch that runs out along its limb and back (a leg contracted to
-  // a flat ribbon collapses to its two rims, joined at the hoof): the run of nodes from the leaf
-  // that lies beside the rest of the branch is threaded into it, so the leaf is where the
-  // branch turned.
+  // a flat ribbon collapses to its two rims, joined at the hoof), or that runs beside another
+  // limb (a rim hanging from the junction as a strand of its own): the run of nodes from the
+  // leaf that lies beside the rest of the branch or another curve edge is threaded into it, so
+  // the leaf is where the branch turned, and a strand beside its limb goes into the limb.
   bool unfold_branches = true;
   // Cut each curve edge longer than two local radii into cross-sections one local radius apart,
   // with a node at the centre of each (the mean of its vertices' centre points), so the curve
