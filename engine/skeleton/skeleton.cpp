@@ -38,6 +38,11 @@ namespace {
 // Skeleton edges, each as (smaller node index, larger node index).
 using EdgeSet = std::set<std::array<std::uint32_t, 2>>;
 
+// Adds the edge (a, b) unless it is a loop or an end is missing (UINT32_MAX).
+void add_edge(EdgeSet& edges, std::uint32_t a, std::uint32_t b) {
+  if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
+}
+
 // Everything about the input surface that node placement and visibility need.
 struct Surface {
   const Mesh& original;
@@ -411,9 +416,6 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
   const Mesh& original = surface.original;
   const std::size_t n = original.positions.size();
   EdgeSet through_air;
-  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
-    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
-  };
   std::vector<std::array<std::uint32_t, 2>> blocked;
   for (const auto& e : edges)
     if (surface.bvh.segment_blocked(sk.nodes[e[0]].position, sk.nodes[e[1]].position)) blocked.push_back(e);
@@ -453,8 +455,8 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
         if (!(keep_cycle && edges.count({std::min(e[0], via[i].second), std::max(e[0], via[i].second)}) &&
               edges.count({std::min(e[1], via[i].second), std::max(e[1], via[i].second)})) &&
             inside_segment(e[0], via[i].second) && inside_segment(via[i].second, e[1])) {
-          add_edge(e[0], via[i].second);
-          add_edge(via[i].second, e[1]);
+          add_edge(edges, e[0], via[i].second);
+          add_edge(edges, via[i].second, e[1]);
           detoured = true;
         }
       if (!detoured) unresolved.push_back(e);
@@ -488,8 +490,8 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
         const auto id = static_cast<std::uint32_t>(sk.nodes.size());
         sk.nodes.push_back(std::move(node));
         node_of_vertex[k] = id;
-        add_edge(e[0], id);
-        add_edge(id, e[1]);
+        add_edge(edges, e[0], id);
+        add_edge(edges, id, e[1]);
         detoured = true;
       }
       if (!detoured) still.push_back(e);
@@ -541,7 +543,7 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
           unrouted.push_back(e);
           continue;
         }
-        for (std::uint32_t y = e[1]; y != e[0]; y = from[y]) add_edge(from[y], y);
+        for (std::uint32_t y = e[1]; y != e[0]; y = from[y]) add_edge(edges, from[y], y);
       }
       log_debug("skeleton: " + std::to_string(still.size() - unrouted.size()) + " of " +
                 std::to_string(still.size()) + " edges re-routed along touching regions");
@@ -642,10 +644,10 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
           const auto id = static_cast<std::uint32_t>(sk.nodes.size());
           sk.nodes.push_back(std::move(node));
           node_of_vertex[k] = id;
-          add_edge(previous, id);
+          add_edge(edges, previous, id);
           previous = id;
         }
-        add_edge(previous, e[1]);
+        add_edge(edges, previous, e[1]);
         return true;
       };
       for (const auto& e : unrouted)
@@ -659,7 +661,7 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
     for (const auto& e : left) {
       const std::uint32_t ra = parts.find(e[0]), rb = parts.find(e[1]);
       if (ra == rb) {
-        add_edge(e[0], e[1]);
+        add_edge(edges, e[0], e[1]);
         through_air.insert(e);
         continue;
       }
@@ -685,7 +687,7 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
           break;
         }
       }
-      add_edge(join[0], join[1]);
+      add_edge(edges, join[0], join[1]);
       parts.unite(join[0], join[1]);
     }
   }
@@ -846,9 +848,6 @@ void prune_cycles(Skeleton& sk, EdgeSet& edges, const EdgeSet& through_air, cons
 void extend_tip(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_of_vertex, const Surface& surface,
                 std::uint32_t leaf, const std::vector<std::vector<std::uint32_t>>& adjacency) {
   const Mesh& original = surface.original;
-  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
-    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
-  };
   if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || sk.nodes[leaf].vertices.size() < 2) return;
   const glm::vec3 p = sk.nodes[leaf].position, q = sk.nodes[adjacency[leaf].front()].position;
   const float len = glm::length(p - q);
@@ -884,7 +883,7 @@ void extend_tip(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_o
   const auto id = static_cast<std::uint32_t>(sk.nodes.size());
   for (std::uint32_t k : node.vertices) node_of_vertex[k] = id;
   sk.nodes.push_back(std::move(node));
-  add_edge(leaf, id);
+  add_edge(edges, leaf, id);
 }
 
 // Curve edges follow the limb between their nodes (s11shape). Grouping leaves nodes up to the
@@ -905,9 +904,6 @@ void extend_tip(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_o
 void add_sections(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node_of_vertex, std::vector<std::uint8_t>& moved,
                   const Surface& surface, const std::vector<std::array<std::uint32_t, 2>>& current) {
   const Mesh& original = surface.original;
-  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
-    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
-  };
   for (const auto& e : current) {
   const std::uint32_t a = e[0], b = e[1];
   if (sk.nodes[a].sheet || sk.nodes[b].sheet) continue;
@@ -972,11 +968,26 @@ void add_sections(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32_t>& node
     for (std::uint32_t k : part) node_of_vertex[k] = id, moved[k] = 1;
     node.vertices = std::move(part);
     sk.nodes.push_back(std::move(node));
-    add_edge(from, id);
+    add_edge(edges, from, id);
     from = id;
   }
-  add_edge(from, b);
+  add_edge(edges, from, b);
   }
+}
+
+// The terminal branch from curve leaf `leaf`: the leaf, its chain of degree-2 curve nodes, and
+// last the node where the chain ends (of another degree, a sheet node, or the leaf again).
+std::vector<std::uint32_t> branch_from(const Skeleton& sk, const std::vector<std::vector<std::uint32_t>>& adjacency,
+                                       std::uint32_t leaf) {
+  std::vector<std::uint32_t> branch{leaf};
+  std::uint32_t prev = leaf, cur = adjacency[leaf].front();
+  while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
+    branch.push_back(cur);
+    const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
+    prev = cur, cur = next;
+  }
+  branch.push_back(cur);
+  return branch;
 }
 
 // Terminal branches covered by the rest of the skeleton: a branch (a leaf and the chain of
@@ -1007,13 +1018,9 @@ void prune_covered_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint3
     std::vector<Branch> branches;
     for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
       if (dead[leaf] || adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet) continue;
-      std::vector<std::uint32_t> path{leaf};
-      std::uint32_t prev = leaf, cur = adjacency[leaf].front();
-      while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
-        path.push_back(cur);
-        const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
-        prev = cur, cur = next;
-      }
+      std::vector<std::uint32_t> path = branch_from(sk, adjacency, leaf);
+      const std::uint32_t cur = path.back();
+      path.pop_back();
       if (adjacency[cur].size() < 3 || sk.nodes[cur].sheet) continue;
       for (std::uint32_t k : path) on_path[k] = 1;
       float excess = -std::numeric_limits<float>::infinity();
@@ -1124,15 +1131,8 @@ void unfold_branches(Skeleton& sk, EdgeSet& edges, const Surface& surface) {
     bool changed = false;
     for (std::uint32_t leaf = 0; leaf < sk.nodes.size(); ++leaf) {
       if (adjacency[leaf].size() != 1 || sk.nodes[leaf].sheet || touched[leaf]) continue;
-      // full: the leaf, its chain, and the node the chain ends at.
-      std::vector<std::uint32_t> full{leaf};
-      std::uint32_t prev = leaf, cur = adjacency[leaf].front();
-      while (adjacency[cur].size() == 2 && !sk.nodes[cur].sheet && cur != leaf) {
-        full.push_back(cur);
-        const std::uint32_t next = adjacency[cur][0] == prev ? adjacency[cur][1] : adjacency[cur][0];
-        prev = cur, cur = next;
-      }
-      full.push_back(cur);
+      const std::vector<std::uint32_t> full = branch_from(sk, adjacency, leaf);
+      const std::uint32_t cur = full.back();
       if (sk.nodes[cur].sheet || std::any_of(full.begin(), full.end(), [&](std::uint32_t x) { return touched[x]; }))
         continue;
       // The curve edges of the rest of the skeleton near the branch (none with an end on the
@@ -1244,7 +1244,7 @@ void unfold_branches(Skeleton& sk, EdgeSet& edges, const Surface& surface) {
         edges.erase({std::min(full[i], full[i + 1]), std::max(full[i], full[i + 1])});
       for (const auto& h : hosts) edges.erase(h), touched[h[0]] = touched[h[1]] = 1;
       for (const auto& c : chains)
-        for (std::size_t i = 0; i + 1 < c.size(); ++i) edges.insert({std::min(c[i], c[i + 1]), std::max(c[i], c[i + 1])});
+        for (std::size_t i = 0; i + 1 < c.size(); ++i) add_edge(edges, c[i], c[i + 1]);
       for (std::uint32_t x : full) touched[x] = 1;
       unfolded += m;
       changed = true;
@@ -1283,8 +1283,9 @@ std::pair<glm::dmat3, glm::dvec3> covariance(const Points& points) {
 }
 
 // `region` split into pieces of connected vertices whose centre points share a cell of
-// kRegionCell * diag (in the order of their first vertex), and whether it is mostly flat:
-// flat pieces of >= 4 vertices hold over half of those pieces' vertices. A piece is flat when
+// kRegionCell * diag (diag: the mesh's bounding-box diagonal; in the order of their first
+// vertex), and whether it is mostly flat: flat pieces of >= 4 vertices hold over half of those
+// pieces' vertices. A piece is flat when
 //   - its centre points spread in two directions (lambda_2 / lambda_1 > kFlatRatio), and
 //   - the region's centre points within twice the piece's thickness t of its mean spread in
 //     their second principal direction over more than t (sqrt(12 lambda_2), a uniform
@@ -1308,9 +1309,9 @@ std::array<std::int64_t, 3> cell_key(const glm::dvec3& q, double cell) {
                                      static_cast<std::int64_t>(std::floor(q.z / cell))};
 }
 
-Pieces split_region(const Surface& surface, const std::vector<std::uint32_t>& region) {
+Pieces split_region(const Surface& surface, double diag, const std::vector<std::uint32_t>& region) {
   const Mesh& original = surface.original;
-  const double cell = kRegionCell * bounding_box(original.positions).diagonal();
+  const double cell = kRegionCell * diag;
   std::map<std::array<std::int64_t, 3>, std::uint32_t> cell_index;
   std::vector<std::uint32_t> cell_of(region.size());
   std::map<std::uint32_t, std::uint32_t> slot;  // vertex -> index in region
@@ -1412,9 +1413,7 @@ void add_protrusion_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint
                              std::vector<std::uint8_t>& moved, const Surface& surface, const SkeletonOptions& options) {
   const Mesh& original = surface.original;
   const std::size_t n = original.positions.size();
-  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
-    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
-  };
+  const double diag = bounding_box(original.positions).diagonal();
   const std::size_t first_new = sk.nodes.size();
   // Mesh neighbours of each vertex (CSR).
   std::vector<std::uint32_t> ring_start(n + 1, 0), ring;
@@ -1513,7 +1512,7 @@ void add_protrusion_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint
       node.radius = surface.radius(p, seeing);
       node.vertices = std::move(seeing);
       sk.nodes.push_back(std::move(node));
-      add_edge(attach, id);
+      add_edge(edges, attach, id);
       return true;
     };
     bool any = false;
@@ -1557,7 +1556,7 @@ void add_protrusion_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint
         any = true;
         continue;
       }
-      const Pieces split = split_region(surface, region);
+      const Pieces split = split_region(surface, diag, region);
       if (split.mostly_flat) continue;
       std::vector<std::pair<float, std::uint32_t>> order;
       for (std::uint32_t i = 0; i < split.pieces.size(); ++i) {
@@ -1841,7 +1840,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       // spread is small), across a plate with a non-convex cross-section they fill the cell.
       // A region whose pieces are mostly flat is a sheet; otherwise each piece gets a node,
       // nearest to the existing skeleton first, so a missed limb becomes a chain of nodes.
-      const Pieces split = split_region(surface, region);
+      const Pieces split = split_region(surface, diag, region);
       if (split.mostly_flat && static_cast<double>(region.size()) >= kSheetRegionShare * static_cast<double>(n)) {
         for (std::uint32_t k : region) region_is_sheet[k] = 1;
         continue;
@@ -1959,10 +1958,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
   watch.lap("sheet nodes");
 
   EdgeSet edges;
-  auto add_edge = [&](std::uint32_t a, std::uint32_t b) {
-    if (a != b && a != UINT32_MAX && b != UINT32_MAX) edges.insert({std::min(a, b), std::max(a, b)});
-  };
-  for (const auto& e : graph.edges) add_edge(node_of_curve[e[0]], node_of_curve[e[1]]);
+  for (const auto& e : graph.edges) add_edge(edges, node_of_curve[e[0]], node_of_curve[e[1]]);
   std::set<Triangle> sheet_seen;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> links;  // (curve node, sheet node)
   for (const Triangle& t : original.triangles) {
@@ -1975,14 +1971,14 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
         if (sheet_seen.insert(key).second) sk.sheet_triangles.push_back(st);
       } else {
         // A triangle that clusters to an edge keeps that edge.
-        for (int i = 0; i < 3; ++i) add_edge(st[i], st[(i + 1) % 3]);
+        for (int i = 0; i < 3; ++i) add_edge(edges, st[i], st[(i + 1) % 3]);
       }
       continue;
     }
     for (int i = 0; i < 3; ++i) {
       const std::uint32_t a = t[i], b = t[(i + 1) % 3];
       if (in_sheet[a] && in_sheet[b])
-        add_edge(node_of_vertex[a], node_of_vertex[b]);  // keeps the sheet connected
+        add_edge(edges, node_of_vertex[a], node_of_vertex[b]);  // keeps the sheet connected
       else if (in_sheet[a] != in_sheet[b])
         links.push_back({node_of_vertex[in_sheet[a] ? b : a], node_of_vertex[in_sheet[a] ? a : b]});
     }
@@ -2006,7 +2002,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       auto [it, inserted] = best.try_emplace({curve, find(sheet)}, d, sheet);
       if (!inserted && d < it->second.first) it->second = {d, sheet};
     }
-    for (const auto& [key, value] : best) add_edge(key.first, value.second);
+    for (const auto& [key, value] : best) add_edge(edges, key.first, value.second);
   }
   const EdgeSet through_air = route_edges_inside(sk, edges, node_of_vertex, surface);
   prune_cycles(sk, edges, through_air, original);
@@ -2044,7 +2040,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       const float reach = std::max(tube, sk.nodes[leaf].radius);
       if (glm::length(p - (a + t * (b - a))) >= reach || surface.bvh.segment_blocked(a, p)) continue;
       edges.erase({std::min(h, f), std::max(h, f)});
-      add_edge(h, leaf);
+      add_edge(edges, h, leaf);
       adjacency[f] = {leaf};
       adjacency[leaf] = {f, h};
       std::replace(adjacency[h].begin(), adjacency[h].end(), f, leaf);
