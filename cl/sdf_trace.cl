@@ -6,8 +6,13 @@
 // several leaves has a record in each, so a leaf's triangles are contiguous in memory): three
 // float4 (v0, e1 = v1 - v0, e2 = v2 - v0) whose w components hold the outward unit normal.
 //
-// Tracing may contract a*b+c into fma: hit distances need not round like any other code.
-#pragma OPENCL FP_CONTRACT ON
+// No contraction of a*b+c into fma anywhere in tracing: the triangle test must round the same
+// way for the two triangles of a shared edge, or a ray through the edge slips between both
+// (on NVIDIA's OpenCL, whose compiler contracts where allowed and whose dot() and cross() may
+// fuse whatever the pragma says, rays through the edges of an axis-aligned face were lost), and
+// the octree's cell planes must round the same from parent and child. The triangle test below
+// writes its products out instead of calling dot() and cross() for the same reason.
+#pragma OPENCL FP_CONTRACT OFF
 //
 // Traversal (after Laine & Karras 2010): the ray's octant mask mirrors the child order, so
 // visiting octants j ^ mask for j = 0..7 is front to back for any ray; each internal node pushes
@@ -33,17 +38,18 @@ inline float3 sdfkit_record_normal(__global const float4* tris, uint f) {
 inline void hit_triangle(__global const float4* tris, uint f, float3 o, float3 d,
                          float* best_t, uint* best_f) {
   const float3 v0 = tris[3 * f].xyz, e1 = tris[3 * f + 1].xyz, e2 = tris[3 * f + 2].xyz;
-  const float3 pv = cross(d, e2);
-  const float det = dot(e1, pv);
+  // cross(d, e2), dot(e1, pv) ... written out, in the bundle test's order (trace_bundles).
+  const float px = d.y * e2.z - d.z * e2.y, py = d.z * e2.x - d.x * e2.z, pz = d.x * e2.y - d.y * e2.x;
+  const float det = e1.x * px + e1.y * py + e1.z * pz;
   if (det == 0.0f) return;
   const float inv_det = 1.0f / det;
-  const float3 tv = o - v0;
-  const float u = dot(tv, pv) * inv_det;
+  const float tx = o.x - v0.x, ty = o.y - v0.y, tz = o.z - v0.z;
+  const float u = (tx * px + ty * py + tz * pz) * inv_det;
   if (u < 0.0f || u > 1.0f) return;
-  const float3 qv = cross(tv, e1);
-  const float v = dot(d, qv) * inv_det;
+  const float qx = ty * e1.z - tz * e1.y, qy = tz * e1.x - tx * e1.z, qz = tx * e1.y - ty * e1.x;
+  const float v = (d.x * qx + d.y * qy + d.z * qz) * inv_det;
   if (v < 0.0f || u + v > 1.0f) return;
-  const float t = dot(e2, qv) * inv_det;
+  const float t = (e2.x * qx + e2.y * qy + e2.z * qz) * inv_det;
   if (t > 0.0f && (t < *best_t || (t == *best_t && *best_f != 0xffffffffu &&
                                    sdfkit_normal_before(sdfkit_record_normal(tris, f),
                                                         sdfkit_record_normal(tris, *best_f))))) {
@@ -245,10 +251,8 @@ __kernel void trace_rays(__global const uint2* nodes, __global const float4* cel
 #if BUNDLE != 8
 #error "trace_bundles is written for bundles of 8 (float8)"
 #endif
-// The bundle's triangle test rounds like the scalar one and the C++ definition's tests: no
-// contraction (with fma, rays through a shared edge of an axis-aligned face slipped between
-// both triangles).
-#pragma OPENCL FP_CONTRACT OFF
+// The bundle's triangle test rounds like the scalar one (hit_triangle) and the C++ definition's
+// tests: the same products in the same order, no contraction (the pragma at the top).
 
 // (min over a's lanes, min over b's lanes), folded pairwise. Also the "does any lane enter"
 // test (a minimum below INFINITY): any() over a vector comparison compiled to a lane-by-lane

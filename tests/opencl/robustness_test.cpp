@@ -315,6 +315,7 @@ TEST(OpenClRobustness, SmallMemoryCapBatchesWithoutChangingResults) {
   cl::OpenClConfig config;
   config.device = std::to_string(shared.device().index);
   config.memory_cap = 100 * (2 * 16 + 30 * 8 + 8) + 5;  // 100 points of 30 rays per batch
+  config.bvh_bundles = true;  // the shared backend's tracer (not the device's default: on a GPU, single rays)
   cl::OpenClBackend small(config);
   EXPECT_EQ(small.batch_points(30), 100u);
   const Mesh mesh = shapes::icosphere(1.0f, 3);  // 642 vertices: 7 batches
