@@ -491,7 +491,7 @@ int run_skeleton_eval(const SkeletonEvalArgs& args, sdfkit::SdfBackend& backend)
     std::string ours, theirs, nosdf;
     if (a.ok) {
       char buf[512];
-      std::snprintf(buf, sizeof buf, "%.2f | %d | %zu | %s | %zu | %zu | %d | %s | %s | %.1f%%", a.seconds,
+      std::snprintf(buf, sizeof buf, "%.3f | %d | %zu | %s | %zu | %zu | %d | %s | %s | %.1f%%", a.seconds,
                     a.iterations, a.nodes, pct(a.nodes ? double(a.sheet_nodes) / a.nodes : 0.0).c_str(),
                     a.leaves, a.branches, a.cycles, frac(a.nodes_inside, a.nodes).c_str(),
                     frac(a.edges_inside, a.edges).c_str(), 100.0 * a.curve_reliability);
@@ -501,7 +501,7 @@ int run_skeleton_eval(const SkeletonEvalArgs& args, sdfkit::SdfBackend& backend)
     }
     if (cg.ok) {
       char buf[256];
-      std::snprintf(buf, sizeof buf, "%s | %zu | %d | %s | %s", num(cg.seconds, "%.2f").c_str(), cg.graph.leaves.size(), cg.cycles,
+      std::snprintf(buf, sizeof buf, "%s | %zu | %d | %s | %s", num(cg.seconds, "%.3f").c_str(), cg.graph.leaves.size(), cg.cycles,
                     pct(a.leaf_match).c_str(), num(a.curve_distance, "%.2f").c_str());
       theirs = buf;
     } else {
@@ -511,7 +511,7 @@ int run_skeleton_eval(const SkeletonEvalArgs& args, sdfkit::SdfBackend& backend)
       nosdf = "| | | | | |";
     } else if (b.ok) {
       char buf[256];
-      std::snprintf(buf, sizeof buf, "%.2f | %s | %zu | %d | %s | %s | %s", b.seconds,
+      std::snprintf(buf, sizeof buf, "%.3f | %s | %zu | %d | %s | %s | %s", b.seconds,
                     pct(b.nodes ? double(b.sheet_nodes) / b.nodes : 0.0).c_str(), b.leaves, b.cycles,
                     frac(b.edges_inside, b.edges).c_str(), pct(b.leaf_match).c_str(),
                     num(b.curve_distance, "%.2f").c_str());
