@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <set>
 #include <vector>
 
 using namespace sdfkit;
@@ -169,6 +171,44 @@ TEST(Topology, AdjacencyOfATetrahedron) {
   for (std::uint32_t i = 0; i < 4; ++i) {
     EXPECT_EQ(v.offsets[i + 1] - v.offsets[i], 3u);
     EXPECT_EQ(f.offsets[i + 1] - f.offsets[i], 3u);
+  }
+}
+
+// The edge grouping behind analyze() and face_adjacency() (a counting sort by the smaller end,
+// or a comparison sort when an index is past the vertices) against a map of every edge's faces,
+// on a random soup over few vertices: repeated indices, edges of one to many faces.
+TEST(Topology, EdgeCountsAndFaceAdjacencyEqualAMapOfEdges) {
+  for (const bool index_past_the_vertices : {false, true}) {
+    Mesh m;
+    for (int i = 0; i < 40; ++i) m.positions.push_back({std::cos(1.3f * i), std::sin(0.7f * i), 0.05f * i});
+    std::uint32_t seed = 12345;
+    const auto next = [&] { return (seed = seed * 1664525u + 1013904223u) >> 8; };
+    for (int f = 0; f < 400; ++f) m.triangles.push_back({next() % 40, next() % 40, next() % 40});
+    if (index_past_the_vertices) m.triangles.push_back({0, 1, 1000});
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> faces_of;
+    for (std::uint32_t f = 0; f < m.triangles.size(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = m.triangles[f][k], b = m.triangles[f][(k + 1) % 3];
+        if (a != b) faces_of[{std::min(a, b), std::max(a, b)}].push_back(f);
+      }
+    std::size_t boundary = 0, non_manifold = 0;
+    std::set<std::pair<std::uint32_t, std::uint32_t>> neighbours;
+    for (const auto& [edge, faces] : faces_of) {
+      boundary += faces.size() == 1;
+      non_manifold += faces.size() >= 3;
+      for (std::uint32_t f : faces)
+        for (std::uint32_t g : faces)
+          if (f != g) neighbours.insert({f, g});
+    }
+    const MeshReport r = analyze(m);
+    EXPECT_EQ(r.boundary_edges, boundary);
+    EXPECT_EQ(r.non_manifold_edges, non_manifold);
+    EXPECT_GT(non_manifold, 0u);
+    const Adjacency adj = face_adjacency(m);
+    std::set<std::pair<std::uint32_t, std::uint32_t>> got;
+    for (std::uint32_t f = 0; f < adj.size(); ++f)
+      for (std::uint32_t i = adj.offsets[f]; i < adj.offsets[f + 1]; ++i) got.insert({f, adj.indices[i]});
+    EXPECT_EQ(got, neighbours);
   }
 }
 

@@ -77,6 +77,8 @@ std::vector<NormalBin> bin_normals(std::span<const glm::vec4> normals, int bins,
 DepthPeelBackend::Impl::DrawGeometry DepthPeelBackend::Impl::prepare_geometry(
     std::span<const glm::vec3> positions) const {
   DrawGeometry g;
+  g.drawn.reserve(triangles.size());
+  g.normals.reserve(triangles.size());
   // Degenerate triangles are never drawn (never ray targets); the rest keep their order.
   for (std::size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
