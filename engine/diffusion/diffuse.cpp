@@ -11,6 +11,7 @@
 #include "sdfkit/diffusion/stm.hpp"
 
 #include "sdfkit/core/error.hpp"
+#include "sdfkit/core/parallel.hpp"
 #include "sdfkit/post/smooth.hpp"
 #include "sdfkit/vulkan/context.hpp"
 #include "sdfkit/vulkan/memory.hpp"
@@ -417,40 +418,64 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   if (!charts.empty()) std::memcpy(chart_buf.mapped(), charts.data(), charts.size() * sizeof(passes::GpuChart));
 
   // Triangle soup: a triangle of a wrapping chart is unwrapped around its first corner and drawn
-  // at every shift by the chart's width that reaches the rectangle (the shader clips).
-  std::vector<passes::RasterVertex> soup;
-  soup.reserve(3 * mapping.triangles.size() + 64);
-  for (const AtlasTriangle& t : mapping.triangles) {
+  // at every shift by the chart's width that reaches the rectangle (the shader clips). Written
+  // straight into its upload buffer, triangles in parallel, each at its offset in mapping order:
+  // a host vector first cost more than all the rest of this preparation on large meshes (its
+  // growth past the reserve for the shifted copies, the first touch of its pages, the copy).
+  const auto unwrapped = [&](const AtlasTriangle& t, glm::vec2 (&uv)[3]) {
+    uv[0] = t.uv[0], uv[1] = t.uv[1], uv[2] = t.uv[2];
     const Chart& ch = mapping.charts[t.chart];
-    const auto& face = mesh.triangles[t.face];
-    glm::vec2 uv[3] = {t.uv[0], t.uv[1], t.uv[2]};
-    const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
+    if (!ch.wraps_x) return std::pair{0, 0};
     const float w = static_cast<float>(ch.width);
-    if (ch.wraps_x)
-      for (int k = 1; k < 3; ++k) {
-        while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
-        while (uv[0].x - uv[k].x > 0.5f * w) uv[k].x += w;
-      }
-    // The map's stretch, and the stretch blur's variance over this triangle per atlas axis:
-    // sigma² less what its own interpolation adds along that axis.
-    const TriangleMap map = triangle_map(x, uv);
-    const glm::vec2 st = triangle_stretch(map);
-    const glm::vec2 var = step.sigma > 0.0f ? triangle_blur_variance(x, map, static_cast<double>(step.sigma)) : glm::vec2(0.0f);
-    if (!ch.wraps_x) {
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k], face[k], t.chart, st, var});
-      continue;
+    for (int k = 1; k < 3; ++k) {
+      while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
+      while (uv[0].x - uv[k].x > 0.5f * w) uv[k].x += w;
     }
     const float lo = std::min({uv[0].x, uv[1].x, uv[2].x}), hi = std::max({uv[0].x, uv[1].x, uv[2].x});
-    for (int s = -2; s <= 2; ++s) {
-      const float shift = static_cast<float>(s) * w;
+    int first = 3, last = -3;  // the shifts s * width, s in [-2, 2], that reach the rectangle
+    for (int sh = -2; sh <= 2; ++sh) {
+      const float shift = static_cast<float>(sh) * w;
       if (hi + shift <= static_cast<float>(ch.x0) || lo + shift >= static_cast<float>(ch.x0) + w) continue;
-      for (int k = 0; k < 3; ++k) soup.push_back({uv[k] + glm::vec2(shift, 0.0f), face[k], t.chart, st, var});
+      first = std::min(first, sh), last = std::max(last, sh);
     }
+    return std::pair{first, last};
+  };
+  const std::size_t T = mapping.triangles.size();
+  std::vector<std::size_t> soup_offset(T + 1, 0);
+  for (std::size_t i = 0; i < T; ++i) {
+    glm::vec2 uv[3];
+    const auto [first, last] = unwrapped(mapping.triangles[i], uv);
+    soup_offset[i + 1] = soup_offset[i] + 3 * static_cast<std::size_t>(mapping.charts[mapping.triangles[i].chart].wraps_x
+                                                                            ? std::max(0, last - first + 1)
+                                                                            : 1);
   }
-  vk::Buffer soup_buf = make_buffer(ctx, soup.size() * sizeof(passes::RasterVertex),
+  const std::size_t soup_vertices = soup_offset[T];
+  vk::Buffer soup_buf = make_buffer(ctx, soup_vertices * sizeof(passes::RasterVertex),
                                     VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                     vk::MemoryUse::Upload);
-  if (!soup.empty()) std::memcpy(soup_buf.mapped(), soup.data(), soup.size() * sizeof(passes::RasterVertex));
+  auto* soup = static_cast<passes::RasterVertex*>(soup_buf.mapped());
+  parallel_for(T, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const AtlasTriangle& t = mapping.triangles[i];
+      const auto& face = mesh.triangles[t.face];
+      glm::vec2 uv[3];
+      const auto [first, last] = unwrapped(t, uv);
+      const glm::vec3 x[3] = {mesh.positions[face[0]], mesh.positions[face[1]], mesh.positions[face[2]]};
+      // The map's stretch, and the stretch blur's variance over this triangle per atlas axis:
+      // sigma² less what its own interpolation adds along that axis.
+      const TriangleMap map = triangle_map(x, uv);
+      const glm::vec2 st = triangle_stretch(map);
+      const glm::vec2 var = step.sigma > 0.0f ? triangle_blur_variance(x, map, static_cast<double>(step.sigma)) : glm::vec2(0.0f);
+      passes::RasterVertex* out = soup + soup_offset[i];
+      if (!mapping.charts[t.chart].wraps_x) {
+        for (int k = 0; k < 3; ++k) *out++ = {uv[k], face[k], t.chart, st, var};
+        continue;
+      }
+      const float w = static_cast<float>(mapping.charts[t.chart].width);
+      for (int sh = first; sh <= last; ++sh)
+        for (int k = 0; k < 3; ++k) *out++ = {uv[k] + glm::vec2(static_cast<float>(sh) * w, 0.0f), face[k], t.chart, st, var};
+    }
+  }, 4096);
 
   // Line jobs of the blur: the rows of the charts whose rows are fused, the other rows, then the
   // columns likewise (passes/atlas_passes.hpp AtlasBlurPass).
@@ -535,7 +560,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   rp.charts = chart_h;
   rp.texels = texels;
   rp.stretch = stretch;
-  rp.vertex_count = static_cast<std::uint32_t>(soup.size());
+  rp.vertex_count = static_cast<std::uint32_t>(soup_vertices);
   rp.size = size;
 
   passes::AtlasBlurPass bp;
