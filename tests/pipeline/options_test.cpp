@@ -132,11 +132,14 @@ TEST(AutoChoice, AGpuBackendOnAGpu) {
   }
   // An OpenCL GPU beside lavapipe: OpenCL.
   EXPECT_EQ(choose_backend({}, {}, std::vector{kLavapipe, kOpenClGpu}).kind, BackendKind::OpenCL);
-  // GPUs on both: the order decides.
-  EXPECT_EQ(choose_backend({}, {}, std::vector{kVulkanGpu, kOpenClGpu}).kind, BackendKind::Vulkan);
-  BackendConfig skeleton;
-  skeleton.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan};
-  EXPECT_EQ(choose_backend(skeleton, {}, std::vector{kVulkanGpu, kOpenClGpu}).kind, BackendKind::OpenCL);
+  // GPUs on both: the order decides, OpenCL first by default (the faster and exact one on the
+  // GPU measured).
+  const BackendChoice both = choose_backend({}, {}, std::vector{kVulkanGpu, kOpenClGpu});
+  EXPECT_EQ(both.kind, BackendKind::OpenCL) << both.reason;
+  EXPECT_NE(both.reason.find("on a GPU"), std::string::npos) << both.reason;
+  BackendConfig peeling_first;
+  peeling_first.auto_order = {BackendKind::Vulkan, BackendKind::OpenCL};
+  EXPECT_EQ(choose_backend(peeling_first, {}, std::vector{kVulkanGpu, kOpenClGpu}).kind, BackendKind::Vulkan);
 }
 
 TEST(AutoChoice, OptionsNarrowItToTheBackendThatHonoursThem) {
@@ -183,7 +186,7 @@ TEST(OptionsJson, EveryOptionChangesTheFingerprint) {
       [](ComputeRequest& r) { r.sdf.domain = SdfDomain::Face; },
       [](ComputeRequest& r) { r.sdf.false_hit = FalseHitRule::Cgal; },
       [](ComputeRequest& r) { r.backend.kind = BackendKind::OpenCL; },
-      [](ComputeRequest& r) { r.backend.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan}; },
+      [](ComputeRequest& r) { r.backend.auto_order = {BackendKind::Vulkan, BackendKind::OpenCL}; },
       [](ComputeRequest& r) { r.backend.device = "1"; },
       [](ComputeRequest& r) { r.backend.views = 64; },
       [](ComputeRequest& r) { r.backend.resolution = 128; },
