@@ -1,5 +1,6 @@
 #include "sdfkit/core/orient.hpp"
 
+#include "sdfkit/core/parallel.hpp"
 #include "sdfkit/core/topology.hpp"
 
 #include <glm/geometric.hpp>
@@ -96,44 +97,68 @@ OrientReport orient_outward(Mesh& mesh) {
   const std::size_t F = mesh.triangles.size();
   if (F == 0) return report;
   // Each edge {a, b} is seen from its smaller end a: the faces around a that use it, as a -> b
-  // (b follows a in the face) or as b -> a (b precedes a). One read of each corner's face.
+  // (b follows a in the face) or as b -> a (b precedes a). One read of each corner's face. The
+  // vertices are walked in parts on all cores (the walk's reads of the faces were a third of
+  // the pass on a 13.3M-triangle mesh); each part lists its joins and open faces in vertex
+  // order, and the joins are made afterwards part by part, in the order one walk would make them.
   ParityUnionFind uf(F);
   std::vector<std::uint8_t> open_face(F, 0);  // touches a boundary or non-manifold edge
   {
     const Adjacency vf = vertex_faces(mesh, /*skip_degenerate=*/true);
-    struct Corner {
-      std::uint32_t face, next, prev;
+    const std::size_t V = vf.size();
+    struct Join {
+      std::uint32_t f0, f1;
+      std::uint8_t differ;  // the two faces use the edge in the same direction
     };
-    std::vector<Corner> around;
-    for (std::uint32_t a = 0; a < vf.size(); ++a) {
-      around.clear();
-      for (std::uint32_t i = vf.offsets[a]; i < vf.offsets[a + 1]; ++i) {
-        const Triangle& t = mesh.triangles[vf.indices[i]];
-        const int k = t[0] == a ? 0 : (t[1] == a ? 1 : 2);
-        around.push_back({vf.indices[i], t[(k + 1) % 3], t[(k + 2) % 3]});
-      }
-      for (std::size_t i = 0; i < around.size(); ++i)
-        for (const std::uint32_t b : {around[i].next, around[i].prev}) {
-          if (b <= a) continue;
-          // Handle edge {a, b} once: at its first use around a.
-          bool earlier = false;
-          for (std::size_t j = 0; j < i && !earlier; ++j) earlier = around[j].next == b || around[j].prev == b;
-          if (earlier || (b == around[i].prev && around[i].next == b)) continue;
-          std::uint32_t uses = 0, f[2] = {0, 0};
-          std::uint8_t forward[2] = {0, 0};
-          for (std::size_t j = i; j < around.size(); ++j)
-            for (const bool fw : {true, false})
-              if ((fw ? around[j].next : around[j].prev) == b) {
-                if (uses < 2) f[uses] = around[j].face, forward[uses] = fw;
-                ++uses;
-              }
-          if (uses == 2) {
-            uf.unite(f[0], f[1], static_cast<std::uint8_t>(forward[0] == forward[1]));
-          } else {
-            for (std::size_t j = i; j < around.size(); ++j)
-              if (around[j].next == b || around[j].prev == b) open_face[around[j].face] = 1;
+    const std::size_t parts = std::max<std::size_t>(1, std::min<std::size_t>(hardware_threads(), V >> 16));
+    std::vector<std::vector<Join>> joins(parts);
+    std::vector<std::vector<std::uint32_t>> opens(parts);
+    parallel_for(parts, [&](std::size_t first_part, std::size_t end_part) {
+      struct Corner {
+        std::uint32_t face, next, prev;
+      };
+      std::vector<Corner> around;
+      for (std::size_t part = first_part; part < end_part; ++part) {
+        std::vector<Join>& join = joins[part];
+        std::vector<std::uint32_t>& open = opens[part];
+        const auto begin = static_cast<std::uint32_t>(V * part / parts), end = static_cast<std::uint32_t>(V * (part + 1) / parts);
+        join.reserve(static_cast<std::size_t>(vf.offsets[end] - vf.offsets[begin]) / 2 + 16);
+        for (std::uint32_t a = begin; a < end; ++a) {
+          around.clear();
+          for (std::uint32_t i = vf.offsets[a]; i < vf.offsets[a + 1]; ++i) {
+            const Triangle& t = mesh.triangles[vf.indices[i]];
+            const int k = t[0] == a ? 0 : (t[1] == a ? 1 : 2);
+            around.push_back({vf.indices[i], t[(k + 1) % 3], t[(k + 2) % 3]});
           }
+          for (std::size_t i = 0; i < around.size(); ++i)
+            for (const std::uint32_t b : {around[i].next, around[i].prev}) {
+              if (b <= a) continue;
+              // Handle edge {a, b} once: at its first use around a.
+              bool earlier = false;
+              for (std::size_t j = 0; j < i && !earlier; ++j) earlier = around[j].next == b || around[j].prev == b;
+              if (earlier || (b == around[i].prev && around[i].next == b)) continue;
+              std::uint32_t uses = 0, f[2] = {0, 0};
+              std::uint8_t forward[2] = {0, 0};
+              for (std::size_t j = i; j < around.size(); ++j)
+                for (const bool fw : {true, false})
+                  if ((fw ? around[j].next : around[j].prev) == b) {
+                    if (uses < 2) f[uses] = around[j].face, forward[uses] = fw;
+                    ++uses;
+                  }
+              if (uses == 2) {
+                join.push_back({f[0], f[1], static_cast<std::uint8_t>(forward[0] == forward[1])});
+              } else {
+                for (std::size_t j = i; j < around.size(); ++j)
+                  if (around[j].next == b || around[j].prev == b) open.push_back(around[j].face);
+              }
+            }
         }
+      }
+    }, 1);
+    for (std::size_t part = 0; part < parts; ++part) {
+      for (const Join& j : joins[part]) uf.unite(j.f0, j.f1, j.differ);
+      for (const std::uint32_t f : opens[part]) open_face[f] = 1;
+      std::vector<Join>().swap(joins[part]);
     }
   }
   // Pieces numbered in the order of their first face; parity relative to that face.

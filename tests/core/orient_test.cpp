@@ -70,6 +70,27 @@ TEST(Orient, MixedWindingsOfAClosedSolidAreUndoneFaceByFace) {
   }
 }
 
+// Over 2^17 vertices the walk around the vertices runs in parts on the cores (one part per 2^16
+// vertices at most); the joins are made afterwards in one walk's order, so the result is the
+// same: scrambled windings undone, an inside-out piece turned, face by face.
+TEST(Orient, AMeshWalkedInPartsIsOrientedFaceByFace) {
+  const Mesh sphere = shapes::icosphere(1.0f, 7);  // 163842 vertices
+  ASSERT_GE(sphere.positions.size(), std::size_t{1} << 17);
+  Mesh torus = shapes::torus(2.0f, 0.5f, 64, 32);
+  for (glm::vec3& p : torus.positions) p.x += 10.0f;
+  const Mesh good = join(sphere, torus);
+  Mesh m = good;
+  const std::size_t scrambled = scramble(m, 7u);
+  for (std::size_t f = sphere.triangles.size(); f < m.triangles.size(); ++f) flip(m.triangles[f]);
+  std::size_t flipped = 0;  // the faces that now differ from the good winding
+  for (std::size_t f = 0; f < m.triangles.size(); ++f) flipped += m.triangles[f] != good.triangles[f];
+  ASSERT_GT(scrambled, sphere.triangles.size() / 4);
+  const OrientReport r = orient_outward(m);
+  EXPECT_EQ(m.triangles, good.triangles);
+  EXPECT_EQ(r.flipped_faces, flipped);
+  EXPECT_EQ(r.pieces, 2u);
+}
+
 TEST(Orient, AnInsideOutSolidIsTurnedAndASecondOneIsNotTouched) {
   const Mesh a = shapes::icosphere(1.0f, 3);
   Mesh b = shapes::torus(2.0f, 0.5f, 32, 16);
