@@ -19,7 +19,7 @@
 #define SDFKIT_UINT std::uint32_t
 #define SDFKIT_DOT glm::dot
 #define SDFKIT_MAX std::max
-#elif defined(__OPENCL_VERSION__)
+#elif defined(__OPENCL_VERSION__) || defined(__OPENCL_C_VERSION__)  // the device version (required), or the language version (clang alone defines only this one)
 #define SDFKIT_FN inline
 #define SDFKIT_VEC3 float3
 #define SDFKIT_UINT uint
