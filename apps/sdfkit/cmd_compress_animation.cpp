@@ -91,9 +91,7 @@ void add_compress_animation_command(CLI::App& app) {
     } else {
       skeleton_points = all.frames;
     }
-    BackendConfig config = a->sdf.backend_config;
-    config.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan};
-    std::unique_ptr<SdfBackend> backend = make_backend(config);
+    std::unique_ptr<SdfBackend> backend = make_backend(a->sdf.backend_config);
     pointcloud::CompressionOptions options;
     options.bones = a->bones;
     options.frame_time = frame_time;

@@ -85,9 +85,7 @@ void add_pointcloud_skeleton_command(CLI::App& app) {
     options.sdf = a->sdf.sdf;
     pointcloud::validate_options(options);
     const pointcloud::FrameSet set = pointcloud::read_frames(a->input, true);
-    BackendConfig config = a->sdf.backend_config;
-    config.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan};
-    std::unique_ptr<SdfBackend> backend = make_backend(config);
+    std::unique_ptr<SdfBackend> backend = make_backend(a->sdf.backend_config);
     const pointcloud::SequenceSkeleton seq = pointcloud::skeleton_sequence(set.frames, *backend, options, a->nodes);
     write_text_atomically(a->output, pointcloud::skeleton_json(seq, set.names, options));
     if (!seq.inexact.empty())

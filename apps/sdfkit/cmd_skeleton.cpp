@@ -68,11 +68,10 @@ void add_skeleton_command(CLI::App& app) {
     if (a->sdf.sdf.domain != SdfDomain::Vertex) throw UsageError("skeletons use the per-vertex SDF (--per vertex)");
     const auto t0 = std::chrono::steady_clock::now();
     const io::Asset asset = load_input(a->input, a->sdf.load);
-    // The pipeline's session: the same contract and automatic choice as `sdfkit compute`; between
-    // two GPU backends OpenCL first (the SDF is recomputed at every contraction iteration).
-    BackendConfig backend_config = a->sdf.backend_config;
-    backend_config.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan};
-    Session session(backend_config, a->sdf.sdf);
+    // The pipeline's session: the same contract and automatic choice as `sdfkit compute` (between
+    // two GPU backends OpenCL first, the cheapest for the SDF recomputed at every contraction
+    // iteration).
+    Session session(a->sdf.backend_config, a->sdf.sdf);
     SdfBackend* backend = &session.backend();
 
     skeleton::ContractionOptions contraction;

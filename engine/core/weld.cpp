@@ -73,7 +73,7 @@ public:
   // of buckets and pushes its vertices in that same order, so the chains do not depend on the
   // thread count.
   void insert_all(std::span<const std::uint64_t> hashes) {
-    const std::size_t threads = hashes.size() < (std::size_t{1} << 16) ? 1 : std::max(1u, std::thread::hardware_concurrency());
+    const std::size_t threads = hashes.size() < (std::size_t{1} << 16) ? 1 : std::size_t{hardware_threads()};
     const std::size_t buckets = mask_ + 1;
     parallel_for(threads, [&](std::size_t tb, std::size_t te) {
       for (std::size_t t = tb; t < te; ++t) {

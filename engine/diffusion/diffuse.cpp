@@ -425,7 +425,7 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   const auto unwrapped = [&](const AtlasTriangle& t, glm::vec2 (&uv)[3]) {
     uv[0] = t.uv[0], uv[1] = t.uv[1], uv[2] = t.uv[2];
     const Chart& ch = mapping.charts[t.chart];
-    if (!ch.wraps_x) return std::pair{0, 0};
+    if (!ch.wraps_x) return std::pair{0, 0};  // drawn once, unshifted
     const float w = static_cast<float>(ch.width);
     for (int k = 1; k < 3; ++k) {
       while (uv[k].x - uv[0].x > 0.5f * w) uv[k].x -= w;
@@ -444,10 +444,8 @@ DiffuseResult Diffuser::run(const Mesh& mesh, const AtlasMapping& mapping, std::
   std::vector<std::size_t> soup_offset(T + 1, 0);
   for (std::size_t i = 0; i < T; ++i) {
     glm::vec2 uv[3];
-    const auto [first, last] = unwrapped(mapping.triangles[i], uv);
-    soup_offset[i + 1] = soup_offset[i] + 3 * static_cast<std::size_t>(mapping.charts[mapping.triangles[i].chart].wraps_x
-                                                                            ? std::max(0, last - first + 1)
-                                                                            : 1);
+    const auto [first, last] = unwrapped(mapping.triangles[i], uv);  // (0, 0): one copy
+    soup_offset[i + 1] = soup_offset[i] + 3 * static_cast<std::size_t>(std::max(0, last - first + 1));
   }
   const std::size_t soup_vertices = soup_offset[T];
   vk::Buffer soup_buf = make_buffer(ctx, soup_vertices * sizeof(passes::RasterVertex),

@@ -118,7 +118,7 @@ void parse_chunk(const std::string& path, std::string_view data, Chunk& c, std::
 
 RawMesh read_obj(const std::string& path, std::string_view data) {
   // Chunks of at least 4 MiB, cut after a line break.
-  const std::size_t threads = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t threads = hardware_threads();
   const std::size_t parts = std::max<std::size_t>(1, std::min(threads, data.size() / (std::size_t{4} << 20)));
   std::vector<Chunk> chunks;
   std::size_t begin = 0;

@@ -564,7 +564,7 @@ Bvh build_bvh(const Mesh& mesh, const BvhParams& params) {
   if (!(params.traversal_cost > 0.0f) || !std::isfinite(params.traversal_cost))
     throw InputError("the BVH traversal cost must be positive, got " + std::to_string(params.traversal_cost));
   if (params.threads < 0) throw InputError("the BVH build's thread count must be 0 (all) or more, got " + std::to_string(params.threads));
-  const unsigned threads = params.threads > 0 ? static_cast<unsigned>(params.threads) : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = params.threads > 0 ? static_cast<unsigned>(params.threads) : hardware_threads();
   Builder b{params, threads, {}};
   // Chunks of faces, each filling the refs of its kept (non-degenerate, as degenerate_faces
   // tells them) faces from its first face's slot on, on all threads; then the runs are moved

@@ -253,7 +253,7 @@ class WideLayout {
  public:
   explicit WideLayout(const Bvh& bvh) : bvh_(bvh) {
     // Small trees (below 2^16 nodes, ~1 ms) on the calling thread: a thread costs ~0.1 ms.
-    threads_ = bvh.nodes.size() < (std::size_t{1} << 16) ? 1u : std::max(1u, std::thread::hardware_concurrency());
+    threads_ = bvh.nodes.size() < (std::size_t{1} << 16) ? 1u : hardware_threads();
     const unsigned threads = threads_;
     grain_ = std::max<std::size_t>(bvh.nodes.size() / (16 * threads), 1);
     top_.reserve(64);

@@ -25,7 +25,6 @@ std::unique_ptr<SdfBackend> backend_for(const std::string& backend, const std::s
   BackendConfig c;
   c.kind = parse_backend_kind(backend);
   c.device = device;
-  c.auto_order = {BackendKind::OpenCL, BackendKind::Vulkan};
   return make_backend(c);
 }
 

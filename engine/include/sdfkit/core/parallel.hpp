@@ -9,10 +9,6 @@
 
 namespace sdfkit {
 
-// Calls body(begin, end) on disjoint ranges covering [0, n), concurrently on up to
-// `max_threads` threads (0 = std::thread::hardware_concurrency()) with about `min_per_thread`
-// items or more each (one range, on the calling thread, when n is below it). `body` must only
-// write per-index state; results are then independent of the thread count.
 // The machine's hardware threads, asked once: glibc answers std::thread::hardware_concurrency()
 // by reading /sys on every call, which cost about 4 % of a skeleton of a mesh of a few hundred
 // vertices, whose loops are mostly too short to split anyway.
@@ -21,6 +17,10 @@ inline unsigned hardware_threads() {
   return threads;
 }
 
+// Calls body(begin, end) on disjoint ranges covering [0, n), concurrently on up to
+// `max_threads` threads (0 = hardware_threads()) with about `min_per_thread`
+// items or more each (one range, on the calling thread, when n is below it). `body` must only
+// write per-index state; results are then independent of the thread count.
 template <class Body>
 void parallel_for(std::size_t n, Body&& body, std::size_t min_per_thread = 1024, unsigned max_threads = 0) {
   const std::size_t wanted = (n + min_per_thread - 1) / std::max<std::size_t>(min_per_thread, 1);
