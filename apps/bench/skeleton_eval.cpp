@@ -5,8 +5,10 @@
 // Per mesh it prints what a skeleton must get right, measured independently of the pipeline:
 // - topology: independent cycles of the skeleton (sdfkit::skeleton::cycle_count) against the
 //   solid's genus, from the Euler characteristic of each connected component of the surface;
-// - containment: nodes inside the solid (ray-parity majority vote) and curve edges whose whole
-//   segment is inside (both ends inside, the segment crosses no triangle);
+// - containment: nodes inside the solid (winding number not 0, majority vote of three rays) and
+//   curve edges whose whole segment is inside (both ends inside, the winding number never 0
+//   between them: TriangleBvh::segment_leaves; where closed pieces overlap, the solid is their
+//   union);
 // - shape: leaves (nodes of degree 1, counting curve edges and sheet-triangle edges), branch
 //   nodes (curve nodes of degree >= 3), share of sheet nodes, curve reliability before sheets;
 // - agreement with CGAL's skeleton: the share of CGAL's leaves that have one of our leaves within
@@ -253,8 +255,7 @@ Eval measure(const sk::Skeleton& s,
   }
   for (const auto& e : s.edges) {
     r.graph.edges.push_back(e);
-    if (inside[e[0]] && inside[e[1]] &&
-        !bvh.segment_blocked(s.nodes[e[0]].position, s.nodes[e[1]].position))
+    if (!bvh.segment_leaves(s.nodes[e[0]].position, s.nodes[e[1]].position))
       ++r.edges_inside;
   }
   return r;

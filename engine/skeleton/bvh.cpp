@@ -1,5 +1,7 @@
 #include "bvh.hpp"
 
+#include "sdfkit/core/union_find.hpp"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -44,6 +46,17 @@ bool hits_box(const glm::vec3& o, const glm::vec3& inv_dir, const glm::vec3& lo,
 }  // namespace
 
 TriangleBvh::TriangleBvh(const Mesh& mesh) : mesh_(&mesh), normals_(face_normals(mesh)) {
+  {
+    UnionFind parts(mesh.positions.size());
+    for (const Triangle& t : mesh.triangles) parts.unite(t[0], t[1]), parts.unite(t[1], t[2]);
+    std::vector<std::uint32_t> lowest(mesh.positions.size(), UINT32_MAX);  // per root
+    component_.resize(mesh.positions.size());
+    for (std::uint32_t k = 0; k < mesh.positions.size(); ++k) {
+      std::uint32_t& named = lowest[parts.find(k)];
+      if (named == UINT32_MAX) named = k;
+      component_[k] = named;
+    }
+  }
   const auto degenerate = degenerate_faces(mesh);
   std::vector<glm::vec3> centroids = face_centroids(mesh);
   for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
@@ -121,8 +134,8 @@ TriangleBvh::Hit TriangleBvh::closest(const glm::vec3& o, const glm::vec3& dir, 
   return hit;
 }
 
-bool TriangleBvh::segment_blocked(const glm::vec3& from, const glm::vec3& to,
-                                  std::uint32_t skip_vertex) const {
+bool TriangleBvh::segment_blocked(const glm::vec3& from, const glm::vec3& to, std::uint32_t skip_vertex,
+                                  std::uint32_t component) const {
   // The segment is traced from its lexicographically smaller end, so that the answer is a
   // property of the segment, not of the direction asked: a segment that grazes a triangle's
   // edge could be blocked one way and clear the other (boeing, oblong-shuffled: curve edges
@@ -138,6 +151,7 @@ bool TriangleBvh::segment_blocked(const glm::vec3& from, const glm::vec3& to,
   traverse(a, dir, 0.0f, tmax, [&](std::uint32_t f) {
     const Triangle& t = mesh_->triangles[f];
     if (t[0] == skip_vertex || t[1] == skip_vertex || t[2] == skip_vertex) return false;
+    if (component != UINT32_MAX && component_[t[0]] != component) return false;
     const float d = intersect(a, dir, mesh_->positions[t[0]], mesh_->positions[t[1]],
                               mesh_->positions[t[2]]);
     blocked = d > 0.0f && d < len;
@@ -146,23 +160,61 @@ bool TriangleBvh::segment_blocked(const glm::vec3& from, const glm::vec3& to,
   return blocked;
 }
 
+namespace {
+const glm::vec3 kSkewDirections[3] = {glm::normalize(glm::vec3(0.5377f, 0.8184f, 0.2026f)),
+                                      glm::normalize(glm::vec3(-0.6651f, 0.1939f, -0.7211f)),
+                                      glm::normalize(glm::vec3(0.1253f, -0.7731f, 0.6218f))};
+}  // namespace
+
+int TriangleBvh::ray_winding(const glm::vec3& p, const glm::vec3& d) const {
+  int winding = 0;
+  float tmax = std::numeric_limits<float>::max();
+  traverse(p, d, 0.0f, tmax, [&](std::uint32_t f) {
+    const Triangle& t = mesh_->triangles[f];
+    if (intersect(p, d, mesh_->positions[t[0]], mesh_->positions[t[1]], mesh_->positions[t[2]]) > 0.0f)
+      winding += glm::dot(normals_[f], d) > 0.0f ? 1 : -1;
+    return false;
+  });
+  return winding;
+}
+
 bool TriangleBvh::inside(const glm::vec3& p) const {
-  static const glm::vec3 dirs[3] = {glm::normalize(glm::vec3(0.5377f, 0.8184f, 0.2026f)),
-                                    glm::normalize(glm::vec3(-0.6651f, 0.1939f, -0.7211f)),
-                                    glm::normalize(glm::vec3(0.1253f, -0.7731f, 0.6218f))};
   int votes = 0;
-  for (const glm::vec3& d : dirs) {
-    int crossings = 0;
-    float tmax = std::numeric_limits<float>::max();
-    traverse(p, d, 0.0f, tmax, [&](std::uint32_t f) {
-      const Triangle& t = mesh_->triangles[f];
-      crossings += intersect(p, d, mesh_->positions[t[0]], mesh_->positions[t[1]],
-                             mesh_->positions[t[2]]) > 0.0f;
-      return false;
-    });
-    votes += crossings % 2;
-  }
+  for (const glm::vec3& d : kSkewDirections) votes += ray_winding(p, d) != 0;
   return votes >= 2;
+}
+
+bool TriangleBvh::segment_leaves(const glm::vec3& from, const glm::vec3& to) const {
+  // From the lexicographically smaller end, as segment_blocked.
+  const bool swap = to.x != from.x ? to.x < from.x : (to.y != from.y ? to.y < from.y : to.z < from.z);
+  const glm::vec3& a = swap ? to : from;
+  const glm::vec3& b = swap ? from : to;
+  if (!inside(a) || !inside(b)) return true;
+  const float len = glm::length(b - a);
+  if (!(len > 0.0f)) return false;
+  const glm::vec3 dir = (b - a) / len;
+  // The crossings between the ends, in order, each changing the winding number by one.
+  std::vector<std::pair<float, int>> crossings;
+  float tmax = len;
+  traverse(a, dir, 0.0f, tmax, [&](std::uint32_t f) {
+    const Triangle& t = mesh_->triangles[f];
+    const float d = intersect(a, dir, mesh_->positions[t[0]], mesh_->positions[t[1]], mesh_->positions[t[2]]);
+    if (d > 0.0f && d < len) crossings.push_back({d, glm::dot(normals_[f], dir) > 0.0f ? -1 : 1});
+    return false;
+  });
+  if (crossings.empty()) return false;
+  std::sort(crossings.begin(), crossings.end());
+  // The winding number at a: the value two of the three rays agree on (a point inside one
+  // piece: 1 on every ray).
+  int votes[3] = {ray_winding(a, kSkewDirections[0]), ray_winding(a, kSkewDirections[1]),
+                  ray_winding(a, kSkewDirections[2])};
+  int winding = votes[0] == votes[1] || votes[0] == votes[2] ? votes[0] : votes[1] == votes[2] ? votes[1] : 0;
+  for (int v : votes) winding = winding == 0 ? v : winding;  // three different values: the first not 0
+  for (const auto& [t, step] : crossings) {
+    winding += step;
+    if (winding == 0) return true;
+  }
+  return false;
 }
 
 }  // namespace sdfkit::skeleton::detail

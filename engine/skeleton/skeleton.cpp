@@ -53,11 +53,19 @@ struct Surface {
   std::vector<glm::vec3> centre;   // per vertex: a point inside the solid seen from the vertex
   std::vector<float> sdf;          // per vertex SDF of the original (may be empty)
   std::vector<std::vector<glm::vec3>> incident_normals;  // per vertex: its faces' normals
+  // Per vertex: its mesh component (bvh.component()). One skeleton per component: a vertex
+  // only ever joins a node of its own component, a node is only ever linked to nodes of its
+  // own, and a vertex sees a point when no face of its own component is in the way. Two bones
+  // that overlap (bones.off) would otherwise see each other's nodes through the solid, and a
+  // vertex inside the other bone would see none of its own bone's nodes.
+  const std::vector<std::uint32_t>& component;
   float far = 0.0f;                // a length beyond the model (2 x bbox diagonal)
 
+  Surface(const Surface&) = delete;  // `component` refers into bvh
+  Surface& operator=(const Surface&) = delete;
   Surface(const Mesh& o, const Mesh& c, const std::vector<float>& s)
       : original(o), contracted(c), bvh(o), normals(vertex_normals(o)),
-        weight(detail::one_ring_areas(o)), sdf(s) {
+        weight(detail::one_ring_areas(o)), sdf(s), component(bvh.component()) {
     const std::vector<glm::vec3> face_n = face_normals(o);
     incident_normals.resize(o.positions.size());
     for (std::size_t f = 0; f < o.triangles.size(); ++f)
@@ -130,8 +138,13 @@ struct Surface {
     }
   }
 
+  // A node's mesh component (its vertices share one); UINT32_MAX for a node without vertices.
+  std::uint32_t component_of(const Node& node) const {
+    return node.vertices.empty() ? UINT32_MAX : component[node.vertices.front()];
+  }
+
   bool sees(std::uint32_t k, const glm::vec3& p) const {
-    return !bvh.segment_blocked(original.positions[k], p, k);
+    return !bvh.segment_blocked(original.positions[k], p, k, component[k]);
   }
 
   // A point inside the solid that vertex k sees: half way from the vertex to the first surface
@@ -269,12 +282,13 @@ struct Surface {
 void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in_sheet,
                      const std::vector<glm::vec3>& point, double spacing, std::vector<Node>& nodes,
                      std::vector<std::uint32_t>& node_of_vertex) {
-  std::map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>> cells;
+  // Cells are per mesh component: a sheet node holds vertices of one component.
+  std::map<std::array<std::int64_t, 4>, std::vector<std::uint32_t>> cells;
   for (std::uint32_t k = 0; k < in_sheet.size(); ++k) {
     if (!in_sheet[k]) continue;
-    std::array<std::int64_t, 3> key{static_cast<std::int64_t>(k), 0, 0};
+    std::array<std::int64_t, 4> key{surface.component[k], static_cast<std::int64_t>(k), 0, 0};
     if (spacing > 0.0)
-      for (int a = 0; a < 3; ++a) key[a] = static_cast<std::int64_t>(std::floor(point[k][a] / spacing));
+      for (int a = 0; a < 3; ++a) key[a + 1] = static_cast<std::int64_t>(std::floor(point[k][a] / spacing));
     cells[key].push_back(k);
   }
   auto add = [&](const glm::vec3& p, std::vector<std::uint32_t> members) {
@@ -314,7 +328,8 @@ void add_sheet_nodes(const Surface& surface, const std::vector<std::uint8_t>& in
       }
       std::vector<std::pair<float, std::size_t>> near;
       for (std::size_t d = 0; d < cell_point.size(); ++d)
-        if (d != c) near.push_back({glm::length(cell_point[d] - point[k]), d});
+        if (d != c && surface.component[cell_members[d]->front()] == surface.component[k])
+          near.push_back({glm::length(cell_point[d] - point[k]), d});
       const std::size_t tried = std::min<std::size_t>(near.size(), 8);
       std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(tried), near.end());
       bool placed = false;
@@ -418,7 +433,7 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
   EdgeSet through_air;
   std::vector<std::array<std::uint32_t, 2>> blocked;
   for (const auto& e : edges)
-    if (surface.bvh.segment_blocked(sk.nodes[e[0]].position, sk.nodes[e[1]].position)) blocked.push_back(e);
+    if (surface.bvh.segment_leaves(sk.nodes[e[0]].position, sk.nodes[e[1]].position)) blocked.push_back(e);
   auto inside_segment = [&](std::uint32_t a, std::uint32_t b) {
     return !surface.bvh.segment_blocked(sk.nodes[a].position, sk.nodes[b].position);
   };
@@ -441,8 +456,9 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
     for (const auto& e : blocked) {
       const glm::vec3 pa = sk.nodes[e[0]].position, pb = sk.nodes[e[1]].position;
       std::vector<std::pair<float, std::uint32_t>> via;
+      const std::uint32_t comp = surface.component_of(sk.nodes[e[0]]);
       for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
-        if (c != e[0] && c != e[1])
+        if (c != e[0] && c != e[1] && surface.component_of(sk.nodes[c]) == comp)
           via.push_back({glm::length(sk.nodes[c].position - pa) + glm::length(sk.nodes[c].position - pb), c});
       const std::size_t tried = std::min<std::size_t>(via.size(), 256);
       std::partial_sort(via.begin(), via.begin() + static_cast<std::ptrdiff_t>(tried), via.end());
@@ -674,7 +690,8 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
       std::vector<std::pair<float, std::array<std::uint32_t, 2>>> pairs;
       for (std::uint32_t a : in_a)
         for (std::uint32_t b : in_b)
-          pairs.push_back({glm::length(sk.nodes[a].position - sk.nodes[b].position), {a, b}});
+          if (surface.component_of(sk.nodes[a]) == surface.component_of(sk.nodes[b]))
+            pairs.push_back({glm::length(sk.nodes[a].position - sk.nodes[b].position), {a, b}});
       const std::size_t tried = std::min<std::size_t>(pairs.size(), 256);
       std::partial_sort(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(tried), pairs.end());
       std::array<std::uint32_t, 2> join = e;
@@ -1483,8 +1500,11 @@ void add_protrusion_branches(Skeleton& sk, EdgeSet& edges, std::vector<std::uint
       const glm::vec3 p = found->point;
       std::vector<std::uint32_t>& seeing = found->seeing;
       std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
+      const std::uint32_t comp = surface.component[part.front()];  // a region is connected
       for (std::uint32_t c = 0; c < sk.nodes.size(); ++c)
-        if (!sk.nodes[c].sheet) curve.push_back({c, sk.nodes[c].position});
+        if (!sk.nodes[c].sheet && !sk.nodes[c].vertices.empty() &&
+            surface.component[sk.nodes[c].vertices.front()] == comp)
+          curve.push_back({c, sk.nodes[c].position});
       const std::uint32_t attach = surface.nearest_seen_node(p, curve);
       if (attach == UINT32_MAX) return false;
       // Each node keeps a vertex: where all of a node's vertices would move, the one nearest
@@ -1677,6 +1697,10 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     for (std::uint32_t k : graph.members[c]) owner[k] = c;
 
   std::vector<std::vector<std::uint32_t>> members = graph.members;
+  // Each curve node's mesh component (the surgery's nodes hold vertices of one component).
+  std::vector<std::uint32_t> curve_component(curve_nodes, UINT32_MAX);
+  for (std::uint32_t c = 0; c < curve_nodes; ++c)
+    if (!members[c].empty()) curve_component[c] = surface.component[members[c].front()];
   std::vector<glm::vec3> position(curve_nodes);
   for (std::uint32_t c = 0; c < curve_nodes; ++c)
     position[c] = surface.place(graph.positions[c], members[c], options.refine_embedding);
@@ -1702,7 +1726,8 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
       const glm::vec3 u = original.positions[k];
       std::vector<std::pair<float, std::uint32_t>> by_distance;
       for (std::uint32_t c = 0; c < curve_nodes; ++c)
-        if (c != owner[k]) by_distance.push_back({glm::length(position[c] - u), c});
+        if (c != owner[k] && curve_component[c] == surface.component[k])
+          by_distance.push_back({glm::length(position[c] - u), c});
       const std::size_t nearest = std::min<std::size_t>(kNearestNodes, by_distance.size());
       std::partial_sort(by_distance.begin(), by_distance.begin() + static_cast<std::ptrdiff_t>(nearest),
                         by_distance.end());
@@ -1739,6 +1764,7 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     if (!node) return false;
     const glm::vec3 p = node->point;
     const std::vector<std::uint32_t>& seeing = node->seeing;
+    const std::uint32_t comp = surface.component[part.front()];  // a region is connected
     // A region whose centre points all lie in the union the curve already stands for is a
     // part of a limb that the curve passes through (vertices in a crease of the limb that see
     // none of its nodes), not a part the skeleton misses: its node goes on the curve edge whose
@@ -1747,7 +1773,9 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     // body's balls) is a part the skeleton misses and gets its branch.
     const auto in_union = [&](const glm::vec3& q) {
       for (const auto& [a, b] : graph.edges)
-        if (outside_swept_ball(q, position[a], node_radius[a], position[b], node_radius[b]) <= 0.0f) return true;
+        if (curve_component[a] == comp &&
+            outside_swept_ball(q, position[a], node_radius[a], position[b], node_radius[b]) <= 0.0f)
+          return true;
       return false;
     };
     bool covered = true;
@@ -1760,7 +1788,9 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     float split_distance = std::numeric_limits<float>::max();
     for (std::size_t i = 0; i < graph.edges.size() && covered; ++i) {
       const auto [a, b] = graph.edges[i];
-      if (outside_swept_ball(p, position[a], node_radius[a], position[b], node_radius[b]) > 0.0f) continue;
+      if (curve_component[a] != comp ||
+          outside_swept_ball(p, position[a], node_radius[a], position[b], node_radius[b]) > 0.0f)
+        continue;
       const float d = distance_to_segment(p, position[a], position[b]);
       if (d < split_distance && !surface.bvh.segment_blocked(position[a], p) && !surface.bvh.segment_blocked(p, position[b]))
         split = i, split_distance = d;
@@ -1768,12 +1798,14 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     std::uint32_t attach = UINT32_MAX;
     if (split == graph.edges.size()) {
       std::vector<std::pair<std::uint32_t, glm::vec3>> curve;
-      for (std::uint32_t c = 0; c < curve_nodes; ++c) curve.push_back({c, position[c]});
+      for (std::uint32_t c = 0; c < curve_nodes; ++c)
+        if (curve_component[c] == comp) curve.push_back({c, position[c]});
       attach = surface.nearest_seen_node(p, curve);
       if (attach == UINT32_MAX) return false;
     }
     const auto c = static_cast<std::uint32_t>(curve_nodes++);
     position.push_back(p);
+    curve_component.push_back(comp);
     node_radius.push_back(surface.radius(p, seeing));
     members.emplace_back();
     graph.members.emplace_back();
@@ -1803,8 +1835,10 @@ Skeleton build(const Surface& surface, const SkeletonOptions& options, const Con
     std::vector<std::pair<float, std::uint32_t>> order;
     for (std::uint32_t i = 0; i < split.pieces.size(); ++i) {
       float best = std::numeric_limits<float>::max();
+      const std::uint32_t first = split.pieces[i].front();
       for (std::uint32_t c = 0; c < curve_nodes; ++c)
-        best = std::min(best, glm::length(position[c] - surface.centre[split.pieces[i].front()]));
+        if (curve_component[c] == surface.component[first])
+          best = std::min(best, glm::length(position[c] - surface.centre[first]));
       order.push_back({best, i});
     }
     std::sort(order.begin(), order.end());

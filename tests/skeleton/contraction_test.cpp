@@ -6,12 +6,14 @@
 
 #include "sdfkit/core/error.hpp"
 #include "sdfkit/core/shapes.hpp"
+#include "sdfkit/core/weld.hpp"
 #include "sdfkit/skeleton/skeleton.hpp"
 #include "sdfkit/skeleton/models.hpp"
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -74,6 +76,72 @@ TEST(SkeletonBvh, InsideAgreesWithTheImplicitTorus) {
     const float f = shapes::torus_sdf(p, 2.0f, 0.6f);
     if (std::abs(f) < 0.05f) continue;  // the tessellation differs from the ideal surface
     EXPECT_EQ(bvh.inside(p), f < 0.0f) << p.x << ' ' << p.y << ' ' << p.z;
+  }
+}
+
+namespace {
+
+// A closed box of side `size` centred at `centre` (welded), wound outward or, with `inward`,
+// inside out (the wall of a cavity).
+Mesh closed_box(float size, const glm::vec3& centre, bool inward = false) {
+  Mesh m = shapes::box(size, size, size, 2);
+  for (glm::vec3& p : m.positions) p += centre;
+  if (inward)
+    for (Triangle& t : m.triangles) std::swap(t[1], t[2]);
+  return weld(m.positions, m.triangles, 1e-6f).mesh;
+}
+
+Mesh joined(const Mesh& a, const Mesh& b) {
+  Mesh m = a;
+  const auto offset = static_cast<std::uint32_t>(m.positions.size());
+  m.positions.insert(m.positions.end(), b.positions.begin(), b.positions.end());
+  for (const Triangle& t : b.triangles) m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return m;
+}
+
+}  // namespace
+
+// The solid of a mesh of closed pieces is where the winding number is not 0: two boxes that
+// overlap are one solid (the overlap is inside, though a ray from it crosses the surface an even
+// number of times), a box wound inward inside another is a cavity (outside), and a segment
+// leaves the solid only where the winding number falls to 0 along it.
+TEST(SkeletonBvh, TheSolidIsTheUnionOfOverlappingPiecesWithoutItsCavities) {
+  {
+    const Mesh m = joined(closed_box(2.0f, glm::vec3(0.0f)), closed_box(2.0f, glm::vec3(1.0f, 0.1f, 0.2f)));
+    const detail::TriangleBvh bvh(m);
+    EXPECT_TRUE(bvh.inside(glm::vec3(0.5f, 0.3f, 0.4f)));  // in both boxes (parity: outside)
+    EXPECT_TRUE(bvh.inside(glm::vec3(-0.5f, 0.0f, 0.0f)));
+    EXPECT_TRUE(bvh.inside(glm::vec3(1.7f, 0.3f, 0.4f)));
+    EXPECT_FALSE(bvh.inside(glm::vec3(3.0f, 0.0f, 0.0f)));
+    const glm::vec3 a(-0.7f, 0.3f, 0.4f), b(1.8f, 0.3f, 0.4f);
+    EXPECT_TRUE(bvh.segment_blocked(a, b));   // it crosses both boxes' walls...
+    EXPECT_FALSE(bvh.segment_leaves(a, b));   // ...without leaving their union
+    EXPECT_FALSE(bvh.segment_leaves(b, a));
+    EXPECT_TRUE(bvh.segment_leaves(a, glm::vec3(3.0f, 0.3f, 0.4f)));
+    // Each piece is a component named by its lowest vertex; a segment tested against one
+    // piece's faces only is not blocked by the other's walls.
+    const auto& component = bvh.component();
+    const std::uint32_t first = component.front(), second = component.back();
+    EXPECT_EQ(first, 0u);
+    EXPECT_NE(second, first);
+    EXPECT_EQ(std::count(component.begin(), component.end(), first), static_cast<long>(m.positions.size() / 2));
+    const glm::vec3 in_first(-0.5f, 0.3f, 0.4f), in_overlap(0.5f, 0.3f, 0.4f);
+    EXPECT_TRUE(bvh.segment_blocked(in_first, in_overlap));
+    EXPECT_FALSE(bvh.segment_blocked(in_first, in_overlap, UINT32_MAX, first));
+    EXPECT_TRUE(bvh.segment_blocked(in_first, in_overlap, UINT32_MAX, second));
+  }
+  {
+    const Mesh m = joined(closed_box(2.0f, glm::vec3(5.0f, 0.0f, 0.0f)), closed_box(2.0f, glm::vec3(0.0f)));
+    const detail::TriangleBvh bvh(m);
+    EXPECT_TRUE(bvh.segment_leaves(glm::vec3(0.0f), glm::vec3(5.0f, 0.0f, 0.0f)));  // two apart
+  }
+  {
+    const Mesh m = joined(closed_box(4.0f, glm::vec3(0.0f)), closed_box(2.0f, glm::vec3(0.0f), true));
+    const detail::TriangleBvh bvh(m);
+    EXPECT_FALSE(bvh.inside(glm::vec3(0.1f, 0.2f, 0.3f)));  // the cavity
+    EXPECT_TRUE(bvh.inside(glm::vec3(1.5f, 0.2f, 0.3f)));   // the wall
+    EXPECT_TRUE(bvh.segment_leaves(glm::vec3(1.5f, 0.2f, 0.3f), glm::vec3(-1.5f, 0.2f, 0.3f)));
+    EXPECT_FALSE(bvh.segment_leaves(glm::vec3(1.5f, 0.2f, 0.3f), glm::vec3(1.5f, -1.5f, 0.3f)));
   }
 }
 

@@ -1,8 +1,8 @@
 // Skeletons of real meshes from CGAL's data set (Embree reference as the SDF backend), held to
 // properties that a skeleton must have whatever the pipeline does inside: one connected part
 // per component, independent cycles = the solid's genus, every node and every point of every
-// curve edge inside the solid (generalized winding number, independent of the library's ray
-// parity test), a leaf near the tip of each limb, few sheet nodes on tubular shapes, and the
+// curve edge inside the solid (generalized winding number by solid angles, independent of the
+// library's ray-crossing test), a leaf near the tip of each limb, few sheet nodes on tubular shapes, and the
 // same output byte for byte across runs. sdfkit_skeleton_bench --eval measures the same
 // quantities over the whole data set (engine/skeleton/README.md).
 
@@ -677,11 +677,44 @@ TEST(SkeletonRealMeshes, ThickLimbIsACurveNotASheet) {
 // boeing the edges grazed a triangle's edge and were checked inside as c -> b but counted
 // outside as b -> c: the BVH's segment test now traces a segment from its lexicographically
 // smaller end. On camel the one bridge whose local detour failed is now routed through the
-// solid's centre points. Held with the library's BVH as the eval counts (nodes inside by ray
-// parity, the segment crosses no triangle, asked from either end) and, on the consistently
+// solid's centre points. Held with the library's BVH (nodes inside by the rays' winding
+// number, the segment crosses no triangle, asked from either end) and, on the consistently
 // oriented camel, independently with the winding number at 15 points along each edge
 // (oblong-shuffled is not consistently oriented and boeing's parts overlap, so neither the
 // winding number nor a parity test at points between the nodes applies there).
+// CGAL's bones.off: 26 closed pieces, some of them through each other at the joints. One
+// skeleton per piece: every node stands for vertices of one piece, every curve edge joins two
+// nodes of one piece, and the skeleton has one part per piece; nodes and curve edges inside the
+// solid (the union of the pieces: winding number > 0). Before the skeleton kept to the pieces,
+// two nodes held vertices of two bones (a vertex inside the other bone saw that bone's node and
+// moved to it) and the edge between them was counted outside.
+TEST(SkeletonRealMeshes, OverlappingPiecesGetOneSkeletonEach) {
+  const Mesh mesh = load("bones.off");
+  const sk::Skeleton s = extract(mesh);
+  expect_valid(mesh, s, "bones.off");
+  UnionFind pieces(mesh.positions.size());
+  for (const Triangle& t : mesh.triangles) pieces.unite(t[0], t[1]), pieces.unite(t[1], t[2]);
+  std::vector<std::uint32_t> piece(s.nodes.size());
+  for (std::size_t i = 0; i < s.nodes.size(); ++i) {
+    std::set<std::uint32_t> of;
+    for (std::uint32_t v : s.nodes[i].vertices) of.insert(pieces.find(v));
+    EXPECT_EQ(of.size(), 1u) << "node " << i << " stands for vertices of " << of.size() << " pieces";
+    piece[i] = *of.begin();
+  }
+  std::size_t outside = 0;
+  for (const auto& e : s.edges) {
+    EXPECT_EQ(piece[e[0]], piece[e[1]]) << "edge " << e[0] << "-" << e[1] << " joins two pieces";
+    for (int i = 1; i < 16; ++i)
+      if (winding_number(mesh, glm::mix(s.nodes[e[0]].position, s.nodes[e[1]].position, static_cast<float>(i) / 16.0f)) < 0.5) {
+        ++outside;
+        break;
+      }
+  }
+  EXPECT_EQ(outside, 0u);
+  EXPECT_EQ(parts(s), 26);
+  EXPECT_GT(s.reliability, 0.99);
+}
+
 TEST(SkeletonRealMeshes, EveryCurveEdgeStaysInsideTheSolid) {
   for (const char* name : {"oblong-shuffled.off", "boeing.off", "camel.off"}) {
     const Mesh mesh = load(name);

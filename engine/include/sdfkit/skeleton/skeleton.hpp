@@ -220,7 +220,10 @@ struct Skeleton {
 // distance from a vertex to its contracted position, centre points come from one ray along the
 // inward normal). With a backend and sdf_term off, the SDF is computed once (radii, grouping,
 // centre points) but not used in the contraction. Every vertex a triangle uses belongs to exactly
-// one node; every node lies inside the solid. Vertices no triangle uses (glTF, OBJ and PLY allow
+// one node; every node lies inside the solid. The mesh must be wound outward (as load_asset and
+// orient_outward leave it): the SDF, the centre points and the inside tests (the winding number:
+// where closed pieces overlap, the solid is their union) read the winding. One skeleton per
+// connected piece: a node stands for vertices of one piece. Vertices no triangle uses (glTF, OBJ and PLY allow
 // them) are not part of the surface: they belong to no node, take no part in the contraction or
 // in the scales taken from the bounding box, and their Skeleton::sdf is 0 (a warning counts them).
 Skeleton extract(const Mesh& mesh, SdfBackend* backend, const ContractionOptions& contraction,
