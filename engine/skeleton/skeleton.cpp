@@ -643,18 +643,39 @@ EdgeSet route_edges_inside(Skeleton& sk, EdgeSet& edges, std::vector<std::uint32
           i = j + 1;
         }
         bool ok = !surface.bvh.segment_blocked(current, pb);
+        // Each waypoint's node stands for one vertex that sees it: the path vertex whose centre
+        // point it is, or, where that vertex's node has no other (a coarse mesh's nodes hold a
+        // few vertices each: mpi_triang), the nearest vertex of the same piece that sees the
+        // waypoint and whose node keeps one.
         std::map<std::uint32_t, std::size_t> taken;  // node -> vertices taken from it
-        for (std::uint32_t k : waypoints) {
+        std::vector<std::uint32_t> owner;            // per waypoint: the vertex its node takes
+        auto spare = [&](std::uint32_t k) {
           const std::uint32_t node = node_of_vertex[k];
-          if (node == UINT32_MAX || sk.nodes[node].vertices.size() < 2 + taken[node]) ok = false;
-          ++taken[node];
+          return node != UINT32_MAX && sk.nodes[node].vertices.size() >= 2 + taken[node] &&
+                 std::find(owner.begin(), owner.end(), k) == owner.end();
+        };
+        for (std::uint32_t k : waypoints) {
+          std::uint32_t chosen = spare(k) ? k : UINT32_MAX;
+          if (chosen == UINT32_MAX) {
+            const glm::vec3 w = surface.centre[k];
+            float best = std::numeric_limits<float>::infinity();
+            for (std::uint32_t v = 0; v < n; ++v) {
+              const float d = glm::length(original.positions[v] - w);
+              if (d < best && surface.component[v] == surface.component[k] && spare(v) && surface.sees(v, w))
+                best = d, chosen = v;
+            }
+          }
+          if (chosen == UINT32_MAX) return false;
+          ++taken[node_of_vertex[chosen]];
+          owner.push_back(chosen);
         }
         if (!ok) return false;
         std::uint32_t previous = e[0];
-        for (std::uint32_t k : waypoints) {
+        for (std::size_t w = 0; w < waypoints.size(); ++w) {
+          const std::uint32_t k = owner[w];
           std::erase(sk.nodes[node_of_vertex[k]].vertices, k);
           Node node;
-          node.position = surface.centre[k];
+          node.position = surface.centre[waypoints[w]];
           node.vertices = {k};
           node.radius = surface.radius(node.position, node.vertices);
           const auto id = static_cast<std::uint32_t>(sk.nodes.size());
