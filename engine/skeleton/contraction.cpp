@@ -83,13 +83,52 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
   auto ms_since = [](Clock::time_point t) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
   };
+  const double wc2 = use_sdf ? options.wc * options.wc : 0.0;
+  // The holding weights' SDF factor: from the input's SDF (HoldingSdf::Initial) or the
+  // thinnest measured so far (Current).
+  auto divide_holding = [&](const std::vector<float>& sdf) {
+    const std::vector<float> norm = normalized(sdf);
+    for (std::size_t i = 0; i < n; ++i) wh[i] /= norm[i] * (1.0 - options.sdf_bias) + options.sdf_bias;
+  };
   for (int it = 0; it < options.max_iterations; ++it) {
     Mesh& current = result.contracted;
-    // The Laplacian term depends only on the current positions and W_L: it is assembled on a
-    // second thread while the SDF is measured (the host mostly waits for the device there).
-    auto laplacian_term = std::async(std::launch::async, [&current, wl] {
+    // The matrix A = W_L^2 L^2 + W_H^2 + W_C^2 depends on the current positions, W_L and the
+    // holding weights, not on this iteration's SDF (which enters the right-hand side through
+    // C), unless the holding weights follow the current SDF. So it is assembled and factorized
+    // on a second thread while the SDF is measured (the host mostly waits for the device
+    // there); with HoldingSdf::Current only the Laplacian term is. The operations are the same
+    // either way, so the result is too.
+    const bool holding_now = use_sdf && it > 0 && options.holding_sdf == HoldingSdf::Initial;
+    if (holding_now) divide_holding(result.first_sdf);
+    const bool factor_early = !use_sdf || it == 0 || holding_now;
+    // The sparsity pattern depends only on the connectivity (every edge is stored, also with
+    // weight 0), so the fill-reducing ordering and symbolic analysis are done once. (Measured
+    // on refined_elephant, 44k vertices: factorization ~0.28 s CPU per iteration; the
+    // quasi-definite augmented system [-I, L; L, D/W_L^2] has the same fill and cost.)
+    auto factorize = [&solver, &pattern_nonzeros, it](Eigen::SparseMatrix<double>& A) {
+      if (it == 0 || A.nonZeros() != pattern_nonzeros) {
+        solver.analyzePattern(A);
+        pattern_nonzeros = A.nonZeros();
+      }
+      solver.factorize(A);
+    };
+    struct System {
+      Eigen::SparseMatrix<double> A;
+      double factor_ms = 0.0;  // 0 when not factorized here
+    };
+    auto system = std::async(std::launch::async, [&current, wl, &wh, wc2, n, factor_early, &factorize, &ms_since] {
+      System sys;
       const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(current);
-      return Eigen::SparseMatrix<double>((wl * wl) * (L * L));  // L is symmetric: L^T L = L L
+      sys.A = (wl * wl) * (L * L);  // L is symmetric: L^T L = L L
+      if (!factor_early) return sys;
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto r = static_cast<Eigen::Index>(i);
+        sys.A.coeffRef(r, r) += wh[i] * wh[i] + wc2;
+      }
+      const auto t = Clock::now();
+      factorize(sys.A);
+      sys.factor_ms = ms_since(t);
+      return sys;
     });
     const auto t_sdf = Clock::now();
     Eigen::MatrixXd C;
@@ -127,41 +166,30 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
       for (std::size_t i = 0; i < n; ++i)
         for (int k = 0; k < 3; ++k)
           C(static_cast<Eigen::Index>(i), k) -= 0.5 * thickness[i] * normals[i][k];
-      if (it > 0) {
-        const std::vector<float> norm = normalized(
-            options.holding_sdf == HoldingSdf::Initial ? result.first_sdf : thickness);
-        for (std::size_t i = 0; i < n; ++i)
-          wh[i] /= norm[i] * (1.0 - options.sdf_bias) + options.sdf_bias;
-      }
     }
 
     const double sdf_ms = ms_since(t_sdf);
     result.sdf_seconds += 1e-3 * sdf_ms;
     const auto t_solve = Clock::now();
-    Eigen::SparseMatrix<double> A = laplacian_term.get();
-    Eigen::VectorXd diagonal(static_cast<Eigen::Index>(n));
+    System sys = system.get();  // the solver is the main thread's again from here
+    if (!factor_early) {
+      divide_holding(thickness);
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto r = static_cast<Eigen::Index>(i);
+        sys.A.coeffRef(r, r) += wh[i] * wh[i] + wc2;
+      }
+      const auto t = Clock::now();
+      factorize(sys.A);
+      sys.factor_ms = ms_since(t);
+    }
+    factor_ms = sys.factor_ms;
     Eigen::MatrixXd rhs(static_cast<Eigen::Index>(n), 3);
-    const double wc2 = use_sdf ? options.wc * options.wc : 0.0;
     for (std::size_t i = 0; i < n; ++i) {
       const auto r = static_cast<Eigen::Index>(i);
       const double wh2 = wh[i] * wh[i];
-      diagonal(r) = wh2 + wc2;
       rhs.row(r) = wh2 * V.row(r);
       if (use_sdf) rhs.row(r) += wc2 * C.row(r);
     }
-    for (Eigen::Index r = 0; r < A.outerSize(); ++r) A.coeffRef(r, r) += diagonal(r);
-
-    // The sparsity pattern depends only on the connectivity (every edge is stored, also with
-    // weight 0), so the fill-reducing ordering and symbolic analysis are done once. (Measured
-    // on refined_elephant, 44k vertices: factorization ~0.28 s CPU per iteration; the
-    // quasi-definite augmented system [-I, L; L, D/W_L^2] has the same fill and cost.)
-    const double build_ms = ms_since(t_solve);
-    if (it == 0 || A.nonZeros() != pattern_nonzeros) {
-      solver.analyzePattern(A);
-      pattern_nonzeros = A.nonZeros();
-    }
-    solver.factorize(A);
-    factor_ms = ms_since(t_solve) - build_ms;
     if (solver.info() != Eigen::Success) {
       result.warnings.push_back("contraction stopped after " + std::to_string(it) +
                                 " iterations: the sparse factorization failed; the last good "
