@@ -189,7 +189,10 @@ bool TriangleBvh::segment_leaves(const glm::vec3& from, const glm::vec3& to) con
   const bool swap = to.x != from.x ? to.x < from.x : (to.y != from.y ? to.y < from.y : to.z < from.z);
   const glm::vec3& a = swap ? to : from;
   const glm::vec3& b = swap ? from : to;
-  if (!inside(a) || !inside(b)) return true;
+  // The winding number at a along the three rays (inside: 2 of them not 0, as inside()).
+  const int votes[3] = {ray_winding(a, kSkewDirections[0]), ray_winding(a, kSkewDirections[1]),
+                        ray_winding(a, kSkewDirections[2])};
+  if ((votes[0] != 0) + (votes[1] != 0) + (votes[2] != 0) < 2 || !inside(b)) return true;
   const float len = glm::length(b - a);
   if (!(len > 0.0f)) return false;
   const glm::vec3 dir = (b - a) / len;
@@ -206,8 +209,6 @@ bool TriangleBvh::segment_leaves(const glm::vec3& from, const glm::vec3& to) con
   std::sort(crossings.begin(), crossings.end());
   // The winding number at a: the value two of the three rays agree on (a point inside one
   // piece: 1 on every ray).
-  int votes[3] = {ray_winding(a, kSkewDirections[0]), ray_winding(a, kSkewDirections[1]),
-                  ray_winding(a, kSkewDirections[2])};
   int winding = votes[0] == votes[1] || votes[0] == votes[2] ? votes[0] : votes[1] == votes[2] ? votes[1] : 0;
   for (int v : votes) winding = winding == 0 ? v : winding;  // three different values: the first not 0
   for (const auto& [t, step] : crossings) {

@@ -105,29 +105,29 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
     // weight 0), so the fill-reducing ordering and symbolic analysis are done once. (Measured
     // on refined_elephant, 44k vertices: factorization ~0.28 s CPU per iteration; the
     // quasi-definite augmented system [-I, L; L, D/W_L^2] has the same fill and cost.)
-    auto factorize = [&solver, &pattern_nonzeros, it](Eigen::SparseMatrix<double>& A) {
-      if (it == 0 || A.nonZeros() != pattern_nonzeros) {
-        solver.analyzePattern(A);
-        pattern_nonzeros = A.nonZeros();
-      }
-      solver.factorize(A);
-    };
     struct System {
       Eigen::SparseMatrix<double> A;
-      double factor_ms = 0.0;  // 0 when not factorized here
+      double factor_ms = 0.0;  // 0 until factorized
     };
-    auto system = std::async(std::launch::async, [&current, wl, &wh, wc2, n, factor_early, &factorize, &ms_since] {
-      System sys;
-      const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(current);
-      sys.A = (wl * wl) * (L * L);  // L is symmetric: L^T L = L L
-      if (!factor_early) return sys;
+    // Adds the holding and centering weights' diagonal to the Laplacian term and factorizes.
+    auto factorize = [&solver, &pattern_nonzeros, it, &wh, wc2, n, &ms_since](System& sys) {
       for (std::size_t i = 0; i < n; ++i) {
         const auto r = static_cast<Eigen::Index>(i);
         sys.A.coeffRef(r, r) += wh[i] * wh[i] + wc2;
       }
       const auto t = Clock::now();
-      factorize(sys.A);
+      if (it == 0 || sys.A.nonZeros() != pattern_nonzeros) {
+        solver.analyzePattern(sys.A);
+        pattern_nonzeros = sys.A.nonZeros();
+      }
+      solver.factorize(sys.A);
       sys.factor_ms = ms_since(t);
+    };
+    auto system = std::async(std::launch::async, [&current, wl, factor_early, &factorize] {
+      System sys;
+      const Eigen::SparseMatrix<double> L = detail::cotangent_laplacian(current);
+      sys.A = (wl * wl) * (L * L);  // L is symmetric: L^T L = L L
+      if (factor_early) factorize(sys);
       return sys;
     });
     const auto t_sdf = Clock::now();
@@ -174,13 +174,7 @@ ContractionResult contract(const Mesh& mesh, SdfBackend* backend, const Contract
     System sys = system.get();  // the solver is the main thread's again from here
     if (!factor_early) {
       divide_holding(thickness);
-      for (std::size_t i = 0; i < n; ++i) {
-        const auto r = static_cast<Eigen::Index>(i);
-        sys.A.coeffRef(r, r) += wh[i] * wh[i] + wc2;
-      }
-      const auto t = Clock::now();
-      factorize(sys.A);
-      sys.factor_ms = ms_since(t);
+      factorize(sys);
     }
     factor_ms = sys.factor_ms;
     Eigen::MatrixXd rhs(static_cast<Eigen::Index>(n), 3);
