@@ -28,7 +28,8 @@
 // --no-conformal (their projections). The blur's width follows the charts' local stretch (DiffuseOptions::stretch)
 // unless --no-stretch (one width per chart). The tex/k column "per chart" gives the same ratio
 // with one width per chart, from the same mapping in the same run (the stretch compensation's
-// own effect), and the summary counts it too.
+// own effect), and the summary counts it too. The result keeps the input's integral per piece
+// (DiffuseOptions::conserve) unless --no-conserve (the blur's own read-back).
 //
 // --steps N: the blur's steps (DiffuseOptions::steps; default 0, automatic from the mapping's reach:
 // the "blur steps" column says how many ran); 1 is the paper's single blur. --no-per-chart skips
@@ -39,7 +40,7 @@
 // against heat over them, and the kind's share of texture space's squared error.
 //
 //   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 8,1] [--steps N] [--no-band] [--no-blend] [--no-conformal] [--no-stretch] [--no-per-chart]
-//                     [--by-kind] [--atlas-size N] [--models] [MESH...]
+//                     [--no-conserve] [--by-kind] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
 #include "sdfkit/core/error.hpp"
@@ -72,7 +73,8 @@ int main(int argc, char** argv) {
   CLI::App app("Seams and heat-diffusion accuracy of texture-space diffusion (issue 13)");
   std::vector<std::string> meshes;
   std::vector<float> sigmas;
-  bool no_band = false, no_blend = false, no_conformal = false, no_stretch = false, by_kind = false, no_per_chart = false;
+  bool no_band = false, no_blend = false, no_conformal = false, no_stretch = false, by_kind = false, no_per_chart = false,
+       no_conserve = false;
   std::uint32_t atlas_size = 2048;
   bool models = false;
   std::uint32_t blur_steps = 0;
@@ -86,6 +88,8 @@ int main(int argc, char** argv) {
                  "(default: the reference's steps, then the issue's single solve)")
       ->capture_default_str();
   app.add_flag("--no-band", no_band, "Charts without the overlap band (one ring of duplicated triangles)");
+  app.add_flag("--no-conserve", no_conserve,
+               "The blur's own read-back, without restoring the input's integral per piece (DiffuseOptions::conserve)");
   app.add_flag("--no-blend", no_blend, "Every vertex read back from its own chart only (no blend over the charts covering it)");
   app.add_flag("--no-conformal", no_conformal, "Joint and sheet charts keep their projections (no least squares conformal maps)");
   app.add_flag("--no-stretch", no_stretch, "One blur width in texels per chart (its mean scale) instead of one per texel from the map's local stretch");
@@ -132,11 +136,12 @@ int main(int argc, char** argv) {
   try {
     vk::Context ctx{vk::ContextConfig{}};
     diffusion::Diffuser diffuser(ctx);
-    std::printf("atlas %u², band %s, %s, %s, %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
+    std::printf("atlas %u², band %s, %s, %s, %s, %s, %s. Seam ratio: P95 jump across chart borders / inside charts (≤ 1.5). "
                 "Against heat diffusion: texture Pearson / median rel. / RMS; k-ring RMS; tex/k = RMS ratio.\n\n",
                 atlas_size, no_band ? "none" : "3 sigma", no_band || no_blend ? "own chart read-back" : "blended read-back",
                 no_conformal ? "projected joint charts" : "conformal joint charts",
                 no_stretch ? "one blur width per chart" : "stretch-compensated blur",
+                no_conserve ? "the read-back as it is" : "integral kept per piece",
                 blur_steps == 0 ? "automatic steps" : (blur_steps == 1 ? "one blur (1 step)" : (std::to_string(blur_steps) + " steps").c_str()));
     std::printf("Heat reference: %d implicit step%s of t / %d", heat_steps[0], heat_steps[0] == 1 ? "" : "s", heat_steps[0]);
     if (heat_steps.size() > 1) std::printf(" (the last column: against %zu more)", heat_steps.size() - 1);
@@ -181,6 +186,7 @@ int main(int argc, char** argv) {
           o.sigma = sigma;
           o.stretch = !no_stretch;
           o.steps = blur_steps;
+          o.conserve = !no_conserve;
           const diffusion::DiffuseResult run = diffuser.run(m, stm.mapping, u, o);
           const std::vector<float>& tex = run.values;
           const double ratio = diffusion::seam_ratio(m, stm.mapping, tex);

@@ -382,7 +382,8 @@ Gaussian blur there on a Vulkan device, read back per vertex. Exactly one of rad
 Gaussian's sigma in atlas texels) and sigma (model units) > 0. steps: the blur as that many
 successive blurs of width / sqrt(steps), each from the values the last read back, so the kernel
 carries on across chart borders (0: as many as the mapping's reach needs; 1: one blur, the
-paper's; at most 256). Returns float32.)doc");
+paper's; at most 256). The result keeps the field's integral over each connected piece and its
+range there, as heat flow does (DiffuseOptions::conserve). Returns float32.)doc");
 #endif
 
   m.def(

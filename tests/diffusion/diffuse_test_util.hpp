@@ -28,6 +28,18 @@ inline std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float
   return diffusion::heat_diffusion(mesh, u0, sigma, steps);
 }
 
+// Lumped (barycentric) vertex areas: a third of each incident triangle's area, the heat
+// reference's mass matrix.
+inline std::vector<double> lumped_areas(const Mesh& mesh) {
+  std::vector<double> area(mesh.positions.size(), 0.0);
+  for (const Triangle& t : mesh.triangles) {
+    const glm::dvec3 a(mesh.positions[t[0]]), b(mesh.positions[t[1]]), c(mesh.positions[t[2]]);
+    const double third = glm::length(glm::cross(b - a, c - a)) / 6.0;
+    for (std::uint32_t v : t) area[v] += third;
+  }
+  return area;
+}
+
 // An open cylinder of radius r and height h around z (shapes::open_cylinder: vertex (i, j) =
 // j * segments + i at angle 2 pi i / segments, height j * h / stacks).
 inline Mesh open_cylinder(float r, float h, int segments, int stacks) { return shapes::open_cylinder(r, h, segments, stacks); }
