@@ -667,7 +667,7 @@ void conserve_integral(const Mesh& mesh, std::span<const float> input, std::span
     for (std::uint32_t v : t) area[v] += a / 3.0;
     pieces.unite(t[0], t[1]), pieces.unite(t[1], t[2]);
   }
-  // Per piece (at its root): area, the input's integral and range, the integral of input - result.
+  // Per piece: area, the input's integral and range, the integral of input - result.
   struct Piece {
     double area = 0.0, integral = 0.0, difference = 0.0, lo = std::numeric_limits<double>::infinity(),
            hi = -std::numeric_limits<double>::infinity();
@@ -702,12 +702,21 @@ void conserve_integral(const Mesh& mesh, std::span<const float> input, std::span
     const double x = result[v] + shift[id[v]], slack = 1e-6 * std::max({p.hi - p.lo, std::abs(p.lo), std::abs(p.hi)});
     p.clamped |= x < p.lo - slack || x > p.hi + slack;
   }
+  // The vertices of the pieces that need a clamp, grouped by piece (one pass, whatever their number).
+  std::vector<std::uint32_t> first(piece.size() + 1, 0), grouped;
+  for (std::uint32_t v = 0; v < V; ++v)
+    if (id[v] != UINT32_MAX && piece[id[v]].clamped) ++first[id[v] + 1];
+  for (std::size_t k = 0; k < piece.size(); ++k) first[k + 1] += first[k];
+  grouped.resize(first.back());
+  {
+    std::vector<std::uint32_t> at(first.begin(), first.end() - 1);
+    for (std::uint32_t v = 0; v < V; ++v)
+      if (id[v] != UINT32_MAX && piece[id[v]].clamped) grouped[at[id[v]]++] = v;
+  }
   for (std::uint32_t k = 0; k < piece.size(); ++k) {
     const Piece& p = piece[k];
     if (!p.clamped) continue;
-    std::vector<std::uint32_t> vertices;
-    for (std::uint32_t v = 0; v < V; ++v)
-      if (id[v] == k) vertices.push_back(v);
+    const std::span<const std::uint32_t> vertices(grouped.data() + first[k], first[k + 1] - first[k]);
     // The integral at c is non-decreasing in c, from area * lo to area * hi, and the input's lies
     // between: bisection.
     double below = std::numeric_limits<double>::infinity(), above = -below;
