@@ -7,6 +7,7 @@
 
 #include "atlas_passes.hpp"
 
+#include "sdfkit/diffusion/heat.hpp"
 #include "sdfkit/diffusion/seams.hpp"
 #include "sdfkit/diffusion/stm.hpp"
 
@@ -659,14 +660,9 @@ void conserve_integral(const Mesh& mesh, std::span<const float> input, std::span
   if (input.size() != V || result.size() != V)
     throw InputError("conserve_integral: " + std::to_string(input.size()) + " and " + std::to_string(result.size()) +
                      " values on a mesh of " + std::to_string(V) + " vertices");
+  const std::vector<double> area = lumped_mass(mesh);
   UnionFind pieces(V);
-  std::vector<double> area(V, 0.0);
-  for (const Triangle& t : mesh.triangles) {
-    const double a = 0.5 * glm::length(glm::dvec3(glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]],
-                                                             mesh.positions[t[2]] - mesh.positions[t[0]])));
-    for (std::uint32_t v : t) area[v] += a / 3.0;
-    pieces.unite(t[0], t[1]), pieces.unite(t[1], t[2]);
-  }
+  for (const Triangle& t : mesh.triangles) pieces.unite(t[0], t[1]), pieces.unite(t[1], t[2]);
   // Per piece: area, the input's integral and range, the integral of input - result.
   struct Piece {
     double area = 0.0, integral = 0.0, difference = 0.0, lo = std::numeric_limits<double>::infinity(),

@@ -12,6 +12,18 @@
 
 namespace sdfkit::diffusion {
 
+std::vector<double> lumped_mass(const Mesh& mesh) {
+  std::vector<double> mass(mesh.vertex_count(), 0.0);
+  for (const auto& tri : mesh.triangles) {
+    const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[tri[0]]), glm::dvec3(mesh.positions[tri[1]]),
+                             glm::dvec3(mesh.positions[tri[2]])};
+    const double twice_area = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+    if (!(twice_area > 0.0)) continue;
+    for (std::uint32_t v : tri) mass[v] += twice_area / 6.0;
+  }
+  return mass;
+}
+
 std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> values, double sigma, int steps) {
   const std::size_t n = mesh.vertex_count();
   if (values.size() != n)
@@ -25,14 +37,13 @@ std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> value
   const auto V = static_cast<Eigen::Index>(n);
   std::vector<Eigen::Triplet<double>> trip;
   trip.reserve(mesh.triangles.size() * 12 + n);
-  std::vector<double> mass(n, 0.0);
+  const std::vector<double> mass = lumped_mass(mesh);
   for (const auto& tri : mesh.triangles) {
     const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[tri[0]]), glm::dvec3(mesh.positions[tri[1]]),
                              glm::dvec3(mesh.positions[tri[2]])};
     const double twice_area = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
     if (!(twice_area > 0.0)) continue;
     for (std::size_t k = 0; k < 3; ++k) {
-      mass[tri[k]] += twice_area / 6.0;
       const auto i = static_cast<Eigen::Index>(tri[(k + 1) % 3]), j = static_cast<Eigen::Index>(tri[(k + 2) % 3]);
       const glm::dvec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
       const double w = 0.5 * glm::dot(a, b) / glm::length(glm::cross(a, b));  // half the cotangent at k

@@ -19,6 +19,11 @@ namespace sdfkit::diffusion {
 // against several steps").
 inline constexpr int kHeatSteps = 8;
 
+// The lumped (barycentric) mass: per vertex, a third of the area of each triangle around it; 0 for
+// a vertex no triangle with area touches. heat_diffusion's M, and the measure whose integral
+// texture-space diffusion keeps (conserve_integral).
+std::vector<double> lumped_mass(const Mesh& mesh);
+
 // One finite value per vertex, sigma > 0, steps >= 1; throws InputError otherwise. Degenerate
 // (zero-area) triangles are skipped; a vertex that no triangle with area touches keeps its value.
 std::vector<float> heat_diffusion(const Mesh& mesh, std::span<const float> values, double sigma, int steps = kHeatSteps);
