@@ -73,6 +73,7 @@ void add_smooth_command(CLI::App& app) {
     bool texture = false;
     float radius = 0.0f;
     std::uint32_t steps = 0;
+    bool no_stretch = false, no_conserve = false;
     std::uint32_t atlas_size = 2048;
     std::string atlas_png, skeleton, device;
     io::LoadOptions load;
@@ -97,6 +98,12 @@ void add_smooth_command(CLI::App& app) {
                   "last read back, so the kernel carries on across chart borders (0 = as many as the mapping's "
                   "reach needs, 1 = one blur, the paper's)")
       ->check(CLI::Range(0u, diffusion::kMaxSteps));
+  cmd->add_flag("--no-stretch", a->no_stretch,
+                "--texture-space with --sigma: one blur width in texels per chart (its mean scale) instead of one per "
+                "texel from the map's local stretch");
+  cmd->add_flag("--no-conserve", a->no_conserve,
+                "--texture-space: keep the blur's own read-back instead of restoring the field's integral over each "
+                "connected piece within its range there (as heat flow keeps it)");
   cmd->add_option("--atlas-size", a->atlas_size, "--texture-space: atlas side in texels (default 2048)")
       ->check(CLI::Range(16, 16384));
   cmd->add_option("--atlas-png", a->atlas_png, "--texture-space: also write the diffused field in the atlas as PNG");
@@ -119,9 +126,11 @@ void add_smooth_command(CLI::App& app) {
         if (given(k)) throw UsageError(std::string(k) + " is k-ring smoothing's; --texture-space takes --radius or --sigma");
       if (given("--radius") == given("--sigma"))
         throw UsageError("--texture-space needs exactly one of --radius (texels) and --sigma (model units)");
+      if (a->no_stretch && given("--radius"))
+        throw UsageError("--no-stretch needs --sigma (a radius in texels is one width everywhere already)");
       if (!a->atlas_png.empty()) check_png_name(a->atlas_png);
     } else {
-      for (const char* k : {"--radius", "--steps", "--atlas-size", "--atlas-png", "--skeleton", "--device"})
+      for (const char* k : {"--radius", "--steps", "--no-stretch", "--no-conserve", "--atlas-size", "--atlas-png", "--skeleton", "--device"})
         if (given(k)) throw UsageError(std::string(k) + " needs --texture-space");
     }
     // An output that cannot hold the values is refused before the work, not after it: the
@@ -137,6 +146,8 @@ void add_smooth_command(CLI::App& app) {
       t.diffuse.radius_px = a->radius;
       t.diffuse.sigma = a->radius > 0.0f ? 0.0f : a->smooth.sigma;
       t.diffuse.steps = a->steps;
+      t.diffuse.stretch = !a->no_stretch;
+      t.diffuse.conserve = !a->no_conserve;
       t.stm.atlas_size = a->atlas_size;
       t.device = a->device;
       skeleton::Skeleton skel;

@@ -358,13 +358,15 @@ exp(-d^2 / (2 sigma^2)); sigma = rings * mean edge length / 2 when 0. Returns fl
   m.def(
       "diffuse",
       [](const py::handle& vertices, const py::handle& faces, const py::handle& values, float radius, float sigma,
-         std::uint32_t steps, std::uint32_t atlas_size, const std::string& device) {
+         std::uint32_t steps, bool stretch, bool conserve, std::uint32_t atlas_size, const std::string& device) {
         const Mesh mesh = to_mesh(vertices, faces, "diffuse");
         const std::vector<float> v = to_values(values, "values");
         diffusion::TextureSmoothOptions options;
         options.diffuse.radius_px = radius;
         options.diffuse.sigma = sigma;
         options.diffuse.steps = steps;
+        options.diffuse.stretch = stretch;
+        options.diffuse.conserve = conserve;
         options.stm.atlas_size = atlas_size;
         options.device = device;
         std::vector<float> out;
@@ -375,15 +377,17 @@ exp(-d^2 / (2 sigma^2)); sigma = rings * mean edge length / 2 when 0. Returns fl
         return to_numpy(std::move(out));
       },
       "vertices"_a, "faces"_a, "values"_a, py::kw_only(), "radius"_a = 0.0f, "sigma"_a = 0.0f, "steps"_a = 0u,
-      "atlas_size"_a = 2048u, "device"_a = "",
+      "stretch"_a = true, "conserve"_a = true, "atlas_size"_a = 2048u, "device"_a = "",
       R"doc(Texture-space diffusion of a per-vertex field (V,) (the paper's section 4.1): the mesh's
 skeleton (from its geometry), a skeleton texture mapping into an atlas_size^2 atlas, and a
 Gaussian blur there on a Vulkan device, read back per vertex. Exactly one of radius (the
 Gaussian's sigma in atlas texels) and sigma (model units) > 0. steps: the blur as that many
 successive blurs of width / sqrt(steps), each from the values the last read back, so the kernel
 carries on across chart borders (0: as many as the mapping's reach needs; 1: one blur, the
-paper's; at most 256). The result keeps the field's integral over each connected piece and its
-range there, as heat flow does (DiffuseOptions::conserve). Returns float32.)doc");
+paper's; at most 256). stretch (with sigma): each texel's blur width follows the map's local
+stretch (False: one width per chart, its mean scale). conserve: the result keeps the field's
+integral over each connected piece and its range there, as heat flow does (False: the blur's own
+read-back). Returns float32.)doc");
 #endif
 
   m.def(

@@ -583,6 +583,22 @@ class UtilityTest(unittest.TestCase):
         self.assertLess(float(np.std(two)), 0.5 * float(np.std(noisy)))
         with self.assertRaisesRegex(sdfkit.InputError, "steps"):
             sdfkit.diffuse(v, f, noisy, sigma=0.1, steps=257, atlas_size=512)
+        # stretch and conserve are honoured: each changes the result; conserve keeps the mean over
+        # the capsule's lumped vertex areas (its integral), which the blur's own read-back drifts from.
+        for kw in ({"stretch": False}, {"conserve": False}):
+            other = sdfkit.diffuse(v, f, noisy, sigma=0.1, atlas_size=512, **kw)
+            self.assertGreater(float(np.max(np.abs(other - diffused))), 1e-5, kw)
+        area = np.zeros(len(v))
+        tri = np.asarray(v, dtype=np.float64)[np.asarray(f)]
+        a = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+        for k in range(3):
+            np.add.at(area, np.asarray(f)[:, k], a / 3.0)
+        kept = sdfkit.diffuse(v, f, noisy, sigma=0.1, atlas_size=512)
+        drift = sdfkit.diffuse(v, f, noisy, sigma=0.1, atlas_size=512, conserve=False)
+        self.assertAlmostEqual(float(area @ kept), float(area @ noisy), delta=1e-4 * float(area @ noisy))
+        self.assertGreater(abs(float(area @ drift) - float(area @ noisy)), abs(float(area @ kept) - float(area @ noisy)))
+        with self.assertRaisesRegex(sdfkit.InputError, "stretch"):
+            sdfkit.diffuse(v, f, noisy, radius=2.0, stretch=False, atlas_size=512)
         with self.assertRaisesRegex(sdfkit.InputError, "exactly one"):
             sdfkit.diffuse(v, f, noisy)
         with self.assertRaisesRegex(sdfkit.InputError, "one value per vertex"):

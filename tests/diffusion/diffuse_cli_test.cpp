@@ -122,7 +122,8 @@ TEST(DiffuseCli, UsageErrorsExitTwo) {
                                   "--texture-space --radius 2 --rings 3", "--radius 2", "--atlas-png a.png",
                                   "--texture-space --radius 2 --atlas-png atlas.jpg",
                                   "--texture-space --radius 2 --atlas-size 8", "--steps 2",
-                                  "--texture-space --radius 2 --steps 257", "--texture-space --radius 2 --steps -1"}) {
+                                  "--texture-space --radius 2 --steps 257", "--texture-space --radius 2 --steps -1",
+                                  "--no-conserve", "--no-stretch", "--texture-space --radius 2 --no-stretch"}) {
     const CommandResult r = run_command(kCli + " smooth " + in + " -o " + out + " " + args, dir.dir());
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_FALSE(std::filesystem::exists(out));
@@ -185,6 +186,18 @@ TEST(DiffuseCli, SmoothTextureSpaceWritesTheResultAndTheAtlas) {
   float most = 0.0f;
   for (std::size_t i = 0; i < v1.values.size(); ++i) most = std::max(most, std::abs(v1.values[i] - v3.values[i]));
   EXPECT_GT(most, 0.0f);
+  // So are --no-stretch and --no-conserve: each changes the result of the same run.
+  const io::FieldFile plain = io::read_field(out, io::ValuesRequired::Yes);
+  for (const std::string flag : {"--no-stretch", "--no-conserve"}) {
+    const std::string file = dir.path("flag.ply");
+    const CommandResult s = run_command(kCli + " smooth " + sdf + " -o " + file + " --texture-space --sigma 0.05 --atlas-size 512 " + flag, dir.dir());
+    ASSERT_EQ(s.exit_code, 0) << flag << ": " << s.err;
+    const io::FieldFile other = io::read_field(file, io::ValuesRequired::Yes);
+    ASSERT_EQ(other.values.size(), plain.values.size());
+    float diff = 0.0f;
+    for (std::size_t i = 0; i < other.values.size(); ++i) diff = std::max(diff, std::abs(other.values[i] - plain.values[i]));
+    EXPECT_GT(diff, 1e-6f) << flag;
+  }
   const io::FieldFile before = io::read_field(sdf, io::ValuesRequired::Yes), after = io::read_field(out, io::ValuesRequired::Yes);
   ASSERT_EQ(before.values.size(), after.values.size());
   float lo = 1e30f, hi = -1e30f, alo = 1e30f, ahi = -1e30f;
