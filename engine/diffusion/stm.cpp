@@ -1530,6 +1530,9 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     }
     std::stable_sort(am.samples.begin(), am.samples.end(),
                      [](const VertexSample& a, const VertexSample& b) { return a.vertex < b.vertex; });
+    const ReadCheck reads = keep_reads_that_see_the_vertex(mesh, am);
+    out.quality.dropped_own_reads = reads.dropped_own;
+    out.quality.borrowed_vertices = reads.borrowed;
   }
 
   // 8. Quality.

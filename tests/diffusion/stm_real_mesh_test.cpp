@@ -115,7 +115,7 @@ TEST(StmExtracted, OverlapBandStaysInReachAndDoesNotFold) {
   EXPECT_GT(band_triangles, mesh.triangles.size());
   // Nor does a band lay its chart over itself (non-wrapping charts; a wrapping bone chart may still
   // fold at a sharp bend): few texels carry two triangles (measured 0.094 %).
-  std::printf("camel, band 6 edges: %.3f %% of the covered texels carry two triangles\n", 100.0 * band.quality.overlap);
+  std::printf("camel, band 6 edges: %.3f %% of the covered texels carry two triangles, %zu of %zu vertices lose their own read, %zu borrow\n", 100.0 * band.quality.overlap, band.quality.dropped_own_reads, mesh.positions.size(), band.quality.borrowed_vertices);
   EXPECT_LT(band.quality.overlap, 0.01);
   for (double bad : {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     dif::StmOptions o;

@@ -300,3 +300,89 @@ TEST(Stm, AtlasPngHasTheAtlasSizeAndRefusesWrongValues) {
   EXPECT_THROW(dif::write_atlas_png(stm.mapping, mesh, std::vector<float>(3, 0.0f), bad), InputError);
   EXPECT_FALSE(std::filesystem::exists(bad));
 }
+
+// keep_reads_that_see_the_vertex on a mapping made by hand: two flat 9 × 9 grids A and B (apart in
+// space: x in [0, 8] and [20, 28]) drawn by one chart with B one texel to the right of A, 2 texels
+// per grid step: a tear. A's last column reads texels B draws; its reads are dropped and it reads
+// where A's nearest clean vertices read, never at B; no read crosses the tear either way; vertices
+// further than 3 texels from it keep their own read alone. With B in a chart of its own, far from
+// A, nothing is dropped.
+TEST(Stm, AReadThatSeesAnotherPartOfTheSurfaceIsDropped) {
+  constexpr std::uint32_t n = 9;
+  Mesh mesh;
+  for (int piece = 0; piece < 2; ++piece)
+    for (std::uint32_t j = 0; j < n; ++j)
+      for (std::uint32_t i = 0; i < n; ++i) mesh.positions.push_back({float(i) + 20.0f * float(piece), float(j), 0.0f});
+  const auto id = [&](int piece, std::uint32_t i, std::uint32_t j) { return static_cast<std::uint32_t>(piece) * n * n + j * n + i; };
+  for (int piece = 0; piece < 2; ++piece)
+    for (std::uint32_t j = 0; j + 1 < n; ++j)
+      for (std::uint32_t i = 0; i + 1 < n; ++i) {
+        mesh.triangles.push_back({id(piece, i, j), id(piece, i + 1, j), id(piece, i + 1, j + 1)});
+        mesh.triangles.push_back({id(piece, i, j), id(piece, i + 1, j + 1), id(piece, i, j + 1)});
+      }
+  const std::uint32_t V = mesh.vertex_count();
+  // A's x in texels: 2.25 + 2 i (its last column at 18.25); B's starts one texel to the right.
+  const float a_last = 2.25f + 2.0f * (n - 1), b_first = a_last + 1.0f;
+  const auto make = [&](bool torn) {
+    dif::AtlasMapping m;
+    m.size = 128;
+    m.gutter = 1;
+    m.charts.push_back({dif::Chart::Kind::Joint, 1, 1, 60, 20, false, 0.5f});
+    if (!torn) m.charts.push_back({dif::Chart::Kind::Joint, 1, 40, 60, 20, false, 0.5f});
+    const auto uv = [&](std::uint32_t v) {
+      const int piece = v >= n * n ? 1 : 0;
+      const std::uint32_t i = (v % (n * n)) % n, j = (v % (n * n)) / n;
+      const float x = piece == 0 ? 2.25f + 2.0f * float(i) : (torn ? b_first : 2.25f) + 2.0f * float(i);
+      const float y = 2.25f + 2.0f * float(j) + (piece == 1 && !torn ? 39.0f : 0.0f);
+      return glm::vec2(x, y);
+    };
+    for (std::uint32_t f = 0; f < mesh.face_count(); ++f) {
+      const Triangle& t = mesh.triangles[f];
+      m.triangles.push_back({t[0] >= n * n && !torn ? 1u : 0u, f, {uv(t[0]), uv(t[1]), uv(t[2])}});
+    }
+    for (std::uint32_t v = 0; v < V; ++v) {
+      m.vertex_chart.push_back(v >= n * n && !torn ? 1u : 0u);
+      m.vertex_uv.push_back(uv(v));
+      m.samples.push_back({v, m.vertex_chart.back(), uv(v), 1.0f});
+    }
+    return m;
+  };
+  dif::AtlasMapping m = make(true);
+  const dif::AtlasMapping before = m;
+  const dif::ReadCheck check = dif::keep_reads_that_see_the_vertex(mesh, m);
+  std::vector<std::vector<dif::VertexSample>> reads(V);
+  for (std::size_t k = 0; k < m.samples.size(); ++k) {
+    if (k > 0) {
+      ASSERT_LE(m.samples[k - 1].vertex, m.samples[k].vertex) << "sorted by vertex";
+    }
+    reads[m.samples[k].vertex].push_back(m.samples[k]);
+  }
+  std::size_t dropped = 0;
+  for (std::uint32_t v = 0; v < V; ++v) {
+    ASSERT_FALSE(reads[v].empty()) << v;
+    const bool in_a = v < n * n;
+    const float x = before.vertex_uv[v].x;
+    for (const dif::VertexSample& s : reads[v]) {
+      EXPECT_EQ(s.uv.x <= a_last, in_a) << "vertex " << v << " reads across the tear at " << s.uv.x;
+      EXPECT_GT(s.weight, 0.0f);
+    }
+    const bool own = reads[v].size() == 1 && reads[v][0].uv == before.vertex_uv[v];
+    if (std::abs(x - (a_last + 0.5f)) > 3.0f) {
+      EXPECT_TRUE(own) << "vertex " << v << " at " << x << " is far from the tear";
+    }
+    if (x == a_last || x == b_first) {
+      EXPECT_FALSE(own) << "vertex " << v << " at " << x << " reads texels of the other grid";
+    }
+    dropped += own ? 0 : 1;
+  }
+  EXPECT_EQ(check.dropped_own, dropped);
+  EXPECT_EQ(check.borrowed, dropped) << "one chart: a dropped read leaves no other";
+  EXPECT_GE(dropped, 2u * n);
+  dif::AtlasMapping apart = make(false);
+  const std::vector<dif::VertexSample> kept = apart.samples;
+  const dif::ReadCheck none = dif::keep_reads_that_see_the_vertex(mesh, apart);
+  EXPECT_EQ(none.dropped_own, 0u);
+  EXPECT_EQ(none.borrowed, 0u);
+  ASSERT_EQ(apart.samples.size(), kept.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) EXPECT_EQ(apart.samples[k].uv, kept[k].uv);
+}

@@ -56,10 +56,12 @@ struct AtlasMapping {
   std::vector<std::uint32_t> vertex_chart;  // V entries: the chart a vertex belongs to (and is read back from)
   std::vector<glm::vec2> vertex_uv;         // V entries: where, in atlas texels (inside that chart)
   // Optional blended read-back: when not empty, a vertex's value is the weight-normalized mean of
-  // the reads of its samples (sorted by vertex, every vertex at least one, its own chart's among
-  // them), each from a chart that covers it (its own, or a neighbour's overlap band), so the
-  // result is continuous across chart borders. Empty: every vertex reads vertex_chart at
-  // vertex_uv alone.
+  // the reads of its samples (sorted by vertex, every vertex at least one), each from a chart that
+  // covers it (its own, or a neighbour's overlap band), so the result is continuous across chart
+  // borders. A read whose texels show another part of the surface next to the vertex (a tear in
+  // the chart, or faces below a texel) is left out; a vertex left with none has the reads of its
+  // nearest vertices instead (build_stm, StmQuality::dropped_own_reads). Empty: every vertex
+  // reads vertex_chart at vertex_uv alone.
   std::vector<VertexSample> samples;
   // Optional, V entries where present: how far around each vertex (model units, along the surface)
   // the chart that covers it deepest reaches before its coverage ends (where its overlap band

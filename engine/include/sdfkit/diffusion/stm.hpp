@@ -137,6 +137,12 @@ struct StmQuality {
   // The same statistics over every chart's faces together (area weighted).
   Stats area_distortion, angle_distortion;
   double band = 0;                 // the overlap band it was built with (StmOptions::overlap), model units
+  // With the blended read-back (AtlasMapping::samples), the reads that do not see the vertex's
+  // surroundings are dropped (a texel next to the read drawn by another part of the surface: a
+  // tear in the chart, or a crumple of faces below a texel; stm.cpp 7b): how many vertices lost
+  // the read of their own chart, and how many of them, left with no read, read where their
+  // nearest vertices read.
+  std::size_t dropped_own_reads = 0, borrowed_vertices = 0;
   double seconds = 0;              // wall-clock time of build_stm
 };
 
@@ -152,6 +158,24 @@ struct Stm {
 // Deterministic. Throws InputError for an empty mesh, a skeleton without nodes, a node vertex
 // out of range, or options out of range.
 Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skeleton, const StmOptions& options = {});
+
+// A read is bilinear over the texels next to its uv, and the blur brings each of them what
+// surrounds it in the chart: a read is only as good as the chart around it. The faces the chart
+// draws over the 4 × 4 texels around the read (those whose centres lie within 1.5 texels of it
+// along each axis) should be one piece of surface around the vertex, joined through their shared
+// corners among themselves. A texel of that block drawn by a face of another piece shows another
+// part of the surface next to the vertex: a tear, where a band went round a fold and met itself,
+// or a crumple of faces smaller than a texel that no texel centre lands in, with the surface
+// beyond it drawn next to it. Such a read is dropped from `am.samples`; a vertex left with none
+// reads what its nearest vertices with one read (the first ring of them, by edges, up to 8
+// rings; each of them counts once; none within 8 rings: its reads stay). Samples stay sorted by
+// vertex; an empty `samples` (no blended read-back) is left as it is. build_stm runs it on every
+// mapping it makes with a band and blending (StmQuality::dropped_own_reads, borrowed_vertices).
+struct ReadCheck {
+  std::size_t dropped_own = 0;  // vertices that lost the read of their own chart
+  std::size_t borrowed = 0;     // of them, those left with none, reading their nearest vertices' reads
+};
+ReadCheck keep_reads_that_see_the_vertex(const Mesh& mesh, AtlasMapping& mapping);
 
 // Reads a skeleton JSON as written by `sdfkit skeleton` / skeleton::to_json (nodes with position,
 // radius, sheet, vertices; edges; sheet_triangles). Throws InputError "<path>: <problem>".
