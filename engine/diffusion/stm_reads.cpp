@@ -39,6 +39,10 @@ ReadCheck keep_reads_that_see_the_vertex(const Mesh& mesh, AtlasMapping& am) {
   for (const AtlasTriangle& t : am.triangles)
     if (t.chart >= C || t.face >= mesh.triangles.size()) throw InputError("the mapping's triangles name a chart or face out of range");
   if (am.vertex_chart.size() != V) throw InputError("the mapping needs one chart per vertex");
+  for (std::size_t k = 1; k < am.samples.size(); ++k)
+    if (am.samples[k].vertex < am.samples[k - 1].vertex) throw InputError("the mapping's samples must be sorted by vertex");
+  for (const Chart& ch : am.charts)
+    if (ch.width == 0 || ch.height == 0) throw InputError("the mapping has a chart of no texels");
   const Adjacency adjacency = vertex_adjacency(mesh);
   const std::vector<std::uint32_t>& adj_start = adjacency.offsets;
   const std::vector<std::uint32_t>& adj = adjacency.indices;

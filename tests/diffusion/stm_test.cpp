@@ -385,4 +385,25 @@ TEST(Stm, AReadThatSeesAnotherPartOfTheSurfaceIsDropped) {
   EXPECT_EQ(none.borrowed, 0u);
   ASSERT_EQ(apart.samples.size(), kept.size());
   for (std::size_t k = 0; k < kept.size(); ++k) EXPECT_EQ(apart.samples[k].uv, kept[k].uv);
+  // A mapping that does not fit the mesh is an input error, not a read out of bounds.
+  dif::AtlasMapping bad = make(true);
+  bad.samples.back().vertex = V;
+  EXPECT_THROW(dif::keep_reads_that_see_the_vertex(mesh, bad), InputError);
+  bad = make(true);
+  bad.triangles.back().face = static_cast<std::uint32_t>(mesh.face_count());
+  EXPECT_THROW(dif::keep_reads_that_see_the_vertex(mesh, bad), InputError);
+  bad = make(true);
+  bad.vertex_chart.pop_back();
+  EXPECT_THROW(dif::keep_reads_that_see_the_vertex(mesh, bad), InputError);
+  bad = make(true);
+  std::swap(bad.samples.front(), bad.samples.back());
+  EXPECT_THROW(dif::keep_reads_that_see_the_vertex(mesh, bad), InputError);
+  bad = make(true);
+  bad.charts[0].width = 0;
+  EXPECT_THROW(dif::keep_reads_that_see_the_vertex(mesh, bad), InputError);
+  // No samples (no blended read-back): nothing to check, nothing changed.
+  bad = make(true);
+  bad.samples.clear();
+  EXPECT_EQ(dif::keep_reads_that_see_the_vertex(mesh, bad).dropped_own, 0u);
+  EXPECT_TRUE(bad.samples.empty());
 }

@@ -171,6 +171,8 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skeleton, const StmOpt
 // rings; each of them counts once; none within 8 rings: its reads stay). Samples stay sorted by
 // vertex; an empty `samples` (no blended read-back) is left as it is. build_stm runs it on every
 // mapping it makes with a band and blending (StmQuality::dropped_own_reads, borrowed_vertices).
+// Throws InputError for a mapping that does not fit the mesh (a sample, triangle or chart index
+// out of range, samples not sorted by vertex, a chart of no texels).
 struct ReadCheck {
   std::size_t dropped_own = 0;  // vertices that lost the read of their own chart
   std::size_t borrowed = 0;     // of them, those left with none, reading their nearest vertices' reads
