@@ -124,6 +124,7 @@ ReadCheck keep_reads_that_see_the_vertex(const Mesh& mesh, AtlasMapping& am) {
     for (std::size_t i = 1; i < cell_start.size(); ++i) cell_start[i] += cell_start[i - 1];
     for (std::uint32_t k = smp_start[c]; k < smp_start[c + 1]; ++k) {
       const VertexSample& s = am.samples[smp_of[k]];
+      if (!std::isfinite(s.uv.x) || !std::isfinite(s.uv.y)) continue;  // no texel to read: dropped
       // The block [bx - 1, bx + 3) × [by - 1, by + 3), chart texels.
       const long bx = static_cast<long>(std::floor(s.uv.x - 0.5)) - static_cast<long>(ch.x0);
       const long by = static_cast<long>(std::floor(s.uv.y - 0.5)) - static_cast<long>(ch.y0);

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 using namespace sdfkit;
 namespace sk = sdfkit::skeleton;
@@ -401,6 +402,10 @@ TEST(Stm, AReadThatSeesAnotherPartOfTheSurfaceIsDropped) {
   bad = make(true);
   bad.charts[0].width = 0;
   EXPECT_THROW(dif::keep_reads_that_see_the_vertex(mesh, bad), InputError);
+  // A read at no texel (a NaN uv) is dropped like one that sees another part of the surface.
+  bad = make(true);
+  bad.samples[0].uv.x = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(dif::keep_reads_that_see_the_vertex(mesh, bad).dropped_own, dropped + 1);
   // No samples (no blended read-back): nothing to check, nothing changed.
   bad = make(true);
   bad.samples.clear();
