@@ -817,6 +817,10 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     build_charts();
     std::vector<std::uint8_t> demote(V, 0);
     bool any = false;
+    // Each bone or cap chart's faces with two or three corners in it: their chart coordinates
+    // and corners, for the overlap test below.
+    std::vector<std::vector<std::array<glm::dvec2, 3>>> uvs(maps.size());
+    std::vector<std::vector<Triangle>> corners(maps.size());
     for (std::size_t f = 0; f < F; ++f) {
       const Triangle& t = mesh.triangles[f];
       std::uint32_t cs[3];
@@ -837,6 +841,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
           for (std::uint32_t v : t)
             if (vchart[v] == cs[i]) demote[v] = 1, any = true;
         }
+        if (own >= 2) uvs[cs[i]].push_back({uv[0], uv[1], uv[2]}), corners[cs[i]].push_back(t);
       }
     }
     // Then where a bone or cap chart's map is not one-to-one: its faces (those with two or three
@@ -845,24 +850,6 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     // covered texels carried two parts of the surface, read back up to 0.17 off heat diffusion
     // at sigma 2 edges on a field of amplitude ~1).
     if (!any) {
-      std::vector<std::vector<std::array<glm::dvec2, 3>>> uvs(maps.size());
-      std::vector<std::vector<Triangle>> corners(maps.size());
-      for (std::size_t f = 0; f < F; ++f) {
-        const Triangle& t = mesh.triangles[f];
-        std::uint32_t cs[3];
-        const int nc = face_charts(f, cs);
-        for (int i = 0; i < nc; ++i) {
-          const ChartMap& m = maps[cs[i]];
-          if (m.kind != Chart::Kind::Bone && !m.cap) continue;
-          int own = 0;
-          for (std::uint32_t v : t) own += vchart[v] == cs[i];
-          if (own < 2) continue;
-          glm::dvec2 uv[3];
-          face_local(f, cs[i], uv);
-          uvs[cs[i]].push_back({uv[0], uv[1], uv[2]});
-          corners[cs[i]].push_back(t);
-        }
-      }
       for (std::size_t c = 0; c < maps.size(); ++c) {
         if (uvs[c].empty()) continue;
         const double period = maps[c].kind == Chart::Kind::Bone && maps[c].wraps ? maps[c].width : 0.0;
