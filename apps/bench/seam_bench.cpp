@@ -6,7 +6,7 @@
 //    different charts, over the same P95 for the edges inside charts (the issue's ≤ 1.5), and
 //    in brackets the same ratio of the heat-diffused field (what the field gives without seams);
 //  - against intrinsic heat diffusion (t = sigma² / 2, cotangent Laplacian, lumped mass; N implicit
-//    steps (M + (t / N) L) u_{k+1} = M u_k, the library's diffusion::kHeatSteps = 8 as the tests,
+//    steps (M + (t / N) L) u_{k+1} = M u_k, the library's diffusion::kHeatSteps = 64 as the tests,
 //    through tests/diffusion/diffuse_test_util.hpp; --heat-steps 1 is the single solve
 //    (M + t L) u = M u0): Pearson, median
 //    relative difference and RMS difference of the texture-space result, and the RMS of k-ring
@@ -17,7 +17,7 @@
 // tex/k, and how many meshes meet seam ratio ≤ 1.5, tex/k ≤ 1, Pearson ≥ 0.95 and median relative
 // difference ≤ 5 %.
 //
-// --heat-steps takes a list (default "8,1": the reference, then the single solve beside it;
+// --heat-steps takes a list (default "64,1": the reference, then the single solve beside it;
 // e.g. 1,8,64): the rows and the seam ratio's bracket use the first;
 // the last column gives Pearson / median rel. / tex/k against each further one, and the summary
 // has one line per sigma and step count (the same texture-space and k-ring results, measured
@@ -39,7 +39,7 @@
 // vertices' own charts, their share of the vertices, the RMS of texture space and of k-ring
 // against heat over them, and the kind's share of texture space's squared error.
 //
-//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 8,1] [--steps N] [--no-band] [--no-blend] [--no-conformal] [--no-stretch] [--no-per-chart]
+//   sdfkit-seam-bench [--sigmas 1,2,3,5] [--heat-steps 64,1] [--steps N] [--no-band] [--no-blend] [--no-conformal] [--no-stretch] [--no-per-chart]
 //                     [--no-conserve] [--by-kind] [--atlas-size N] [--models] [MESH...]
 #include "../../tests/diffusion/diffuse_test_util.hpp"
 
