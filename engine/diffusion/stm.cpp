@@ -1083,12 +1083,23 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
     // face's residual Σ_j W_j ζ_j / √(2 area) (W_j = z_{j+2} - z_{j+1} in the face's own plane,
     // ζ = u + i v), zero exactly for a similarity; the chart's two vertices farthest apart in its
     // projection pinned at their distance. A band face that turns against the chart's own faces,
-    // is squashed (σ1/σ2 > max_stretch) or stretched past max_stretch leaves the domain (into
-    // `trimmed`) and the map is solved again, up to 4 times; false (nothing kept) when one of the
-    // chart's own faces does, the map folds over itself, or the solve fails.
+    // is squashed (σ1/σ2 > max_stretch), stretched past max_stretch, overlaps a face nearer the
+    // chart or is not joined to the chart's faces across edges leaves the domain (into `trimmed`)
+    // and the map is solved again, up to 4 times; false (nothing kept) when one of the chart's own
+    // faces does one of the first four, or the solve fails. `seeded_by_unfolding`: the band was
+    // laid out by unfolding (`unfolded`), which then says how its faces are oriented.
     std::vector<std::int32_t> lscm_index(V, -1);
+    // Band growth by unfolding (below): per vertex, its place in the chart's plane, and which
+    // vertices have one.
+    std::vector<glm::dvec2> unfolded(V);
+    std::vector<std::uint8_t> has_unfolded(V, 0);
+    std::vector<std::uint32_t> unfolded_touched;
+    // A band's reach round its chart's vertices (below): per vertex, -1 where covered and not yet
+    // reached, else the distance to where the coverage ends; infinity where not covered.
+    std::vector<double> depth(V, std::numeric_limits<double>::infinity());
+    std::vector<std::uint32_t> depth_touched;
     const auto conformal_map = [&](std::uint32_t c, std::vector<std::uint32_t> domain, double orientation,
-                                   std::vector<std::uint32_t>& trimmed) {
+                                   bool seeded_by_unfolding, std::vector<std::uint32_t>& trimmed) {
       std::uint32_t pa = kNone, pb = kNone;
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
       for (std::uint32_t v : chart_vertices[c]) {
@@ -1101,10 +1112,13 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       // Whether each domain face is oriented like the chart's own faces in the projection: a face
       // touching the chart that the projection already flipped has no say below.
       std::vector<std::uint8_t> says(domain.size());
+      // With an unfolded band, its faces' say comes from their unfolded places.
       for (std::size_t i = 0; i < domain.size(); ++i) {
         const Triangle& t = mesh.triangles[domain[i]];
         glm::dvec2 pr[3];
-        for (int k = 0; k < 3; ++k) pr[k] = local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
+        bool unf = seeded_by_unfolding;
+        for (int k = 0; k < 3; ++k) unf = unf && has_unfolded[t[k]];
+        for (int k = 0; k < 3; ++k) pr[k] = unf ? unfolded[t[k]] : local_coords(maps[c], B, glm::dvec3(mesh.positions[t[k]]));
         says[i] = orientation * signed_area2(pr[0], pr[1], pr[2]) > 0;
       }
       std::vector<std::uint32_t> verts, bad;
@@ -1112,8 +1126,46 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         for (std::uint32_t v : verts) lscm_index[v] = -1;
         verts.clear();
       };
+      const auto own_face = [&](const Triangle& t) { return vchart[t[0]] == c || vchart[t[1]] == c || vchart[t[2]] == c; };
+      std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;
+      std::vector<std::uint8_t> joined;
+      std::vector<std::uint32_t> reach_queue;
       for (int round = 0; round < 4; ++round) {
         cleanup();
+        // An unfolded band keeps only faces joined to the chart's own faces across edges inside
+        // the domain: a piece that hangs on by a corner, or that trimming cut off, has no unique
+        // conformal map.
+        edges.clear();
+        for (std::size_t i = 0; i < domain.size(); ++i) {
+          const Triangle& t = mesh.triangles[domain[i]];
+          for (int k = 0; k < 3; ++k) {
+            const std::uint32_t a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
+            edges.push_back({(static_cast<std::uint64_t>(a) << 32) | b, static_cast<std::uint32_t>(i)});
+          }
+        }
+        std::sort(edges.begin(), edges.end());
+        joined.assign(domain.size(), 0);
+        reach_queue.clear();
+        for (std::size_t i = 0; i < domain.size(); ++i)
+          if (own_face(mesh.triangles[domain[i]])) joined[i] = 1, reach_queue.push_back(static_cast<std::uint32_t>(i));
+        for (std::size_t q = 0; q < reach_queue.size(); ++q) {
+          const Triangle& t = mesh.triangles[domain[reach_queue[q]]];
+          for (int k = 0; k < 3; ++k) {
+            const std::uint32_t a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
+            const std::uint64_t key = (static_cast<std::uint64_t>(a) << 32) | b;
+            for (auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, std::uint32_t{0}));
+                 it != edges.end() && it->first == key; ++it)
+              if (!joined[it->second]) joined[it->second] = 1, reach_queue.push_back(it->second);
+          }
+        }
+        if (seeded_by_unfolding && reach_queue.size() < domain.size()) {
+          std::size_t kept = 0;
+          for (std::size_t i = 0; i < domain.size(); ++i)
+            if (joined[i]) domain[kept] = domain[i], says[kept++] = says[i];
+            else trimmed.push_back(domain[i]);
+          domain.resize(kept);
+          says.resize(kept);
+        }
         for (std::uint32_t f : domain)
           for (std::uint32_t v : mesh.triangles[f])
             if (lscm_index[v] < 0) lscm_index[v] = static_cast<std::int32_t>(verts.size()), verts.push_back(v);
@@ -1166,7 +1218,6 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         };
         // The orientation of the chart's own faces (up to a mirror, the projection's), and the
         // faces that turn against it, are squashed or stretched.
-        const auto own_face = [&](const Triangle& t) { return vchart[t[0]] == c || vchart[t[1]] == c || vchart[t[2]] == c; };
         double votes = 0;
         for (std::size_t i = 0; i < domain.size(); ++i) {
           const Triangle& t = mesh.triangles[domain[i]];
@@ -1197,6 +1248,24 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
           bad.push_back(f);
         }
         if (own_bad) return cleanup(), false;
+        // Nor folded over itself (the band's overlap test, on the new coordinates). In an unfolded
+        // band, of two faces that overlap, the one farther out (later in the domain) leaves it.
+        if (bad.empty()) {
+          grid.clear();
+          grid_entries.clear();
+          grid_tris.clear();
+          grid_faces.clear();
+          for (std::uint32_t f : domain) {
+            const Triangle& t = mesh.triangles[f];
+            const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
+            if (grid_overlaps(f, uv)) {
+              if (!seeded_by_unfolding || own_face(t)) return cleanup(), false;
+              bad.push_back(f);
+              continue;
+            }
+            grid_insert(f, uv);
+          }
+        }
         if (!bad.empty()) {
           if (round == 3) return cleanup(), false;
           std::sort(bad.begin(), bad.end());
@@ -1207,17 +1276,6 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
           says.resize(kept);
           trimmed.insert(trimmed.end(), bad.begin(), bad.end());
           continue;
-        }
-        // Nor folded over itself (the band's overlap test, on the new coordinates).
-        grid.clear();
-        grid_entries.clear();
-        grid_tris.clear();
-        grid_faces.clear();
-        for (std::uint32_t f : domain) {
-          const Triangle& t = mesh.triangles[f];
-          const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
-          if (grid_overlaps(f, uv)) return cleanup(), false;
-          grid_insert(f, uv);
         }
         // Mirrored to the projection's orientation, so the band's orientation test still holds.
         auto& table = conformal[c];
@@ -1285,65 +1343,216 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         orientation += signed_area2(uv[0], uv[1], uv[2]) > 0 ? 1 : -1;
       }
       const double sign = orientation >= 0 ? 1.0 : -1.0;
-      // Grow from the faces the chart holds through vertex-adjacent faces in reach.
+      // Grow from the faces the chart holds through vertex-adjacent faces in reach (`radius`).
+      // `unfold` (charts that take a conformal map): a corner keeps the place it got first, and
+      // a face the projection does not fit is unfolded, laid into the plane in its own shape (a
+      // similarity) onto an edge whose ends are placed already, so the band goes round a sharp
+      // edge or onto a side the projection sees edge-on, where heat flow goes too (CAD parts,
+      // whose planar charts meet at sharp edges: every band stopped there, and the blur saw each
+      // side alone). A face with fewer than two corners placed that the projection does not fit
+      // waits for a neighbour to place a second.
       const std::size_t band_begin = local.size();
-      faces = held[c];
-      for (std::uint32_t f : faces) face_state[f] = 1;
-      for (std::size_t i = 0; i < faces.size(); ++i)
-        for (std::uint32_t v : mesh.triangles[faces[i]])
-          for (std::uint32_t k = vf_start[v]; k < vf_start[v + 1]; ++k) {
-            const std::uint32_t g = vf[k];
-            if (face_state[g]) continue;
-            const Triangle& t = mesh.triangles[g];
-            if (!(std::min({dist[t[0]], dist[t[1]], dist[t[2]]}) <= options.overlap)) continue;
-            LocalTri lt{c, g, {}};
-            face_local(g, c, lt.uv);
-            const glm::dvec3 p0(mesh.positions[t[0]]), p1(mesh.positions[t[1]]), p2(mesh.positions[t[2]]);
-            const double model = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
-            const double loc = std::max({glm::length(lt.uv[1] - lt.uv[0]), glm::length(lt.uv[2] - lt.uv[1]),
-                                         glm::length(lt.uv[0] - lt.uv[2])});
-            bool ok = sign * signed_area2(lt.uv[0], lt.uv[1], lt.uv[2]) > 0 && loc <= options.max_stretch * model;
-            if (ok) {
-              if (grid_overlaps(g, lt.uv)) ok = false;
-              else insert_wrapped(g, lt.uv);
+      const glm::dvec2 lo_before = maps[c].lo, hi_before = maps[c].hi;
+      // Returns how many faces were unfolded.
+      const auto grow = [&](bool unfold, double radius) {
+        std::size_t unfolded_faces = 0;
+        faces = held[c];
+        for (std::uint32_t f : faces) face_state[f] = 1;
+        if (unfold)
+          for (std::uint32_t f : held[c]) {
+            glm::dvec2 uv[3];
+            face_local(f, c, uv);
+            for (int k = 0; k < 3; ++k) {
+              const std::uint32_t v = mesh.triangles[f][k];
+              if (has_unfolded[v]) continue;
+              has_unfolded[v] = 1, unfolded[v] = uv[k];
+              unfolded_touched.push_back(v);
             }
-            face_state[g] = ok ? 1 : 2;
-            faces.push_back(g);
-            if (!ok) continue;
-            local.push_back(lt);
-            ChartMap& m = maps[c];
-            for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
           }
+        for (std::size_t i = 0; i < faces.size(); ++i)
+          for (std::uint32_t v : mesh.triangles[faces[i]])
+            for (std::uint32_t k = vf_start[v]; k < vf_start[v + 1]; ++k) {
+              const std::uint32_t g = vf[k];
+              if (face_state[g]) continue;
+              const Triangle& t = mesh.triangles[g];
+              if (!(std::min({dist[t[0]], dist[t[1]], dist[t[2]]}) <= radius)) continue;
+              LocalTri lt{c, g, {}};
+              const glm::dvec3 p0(mesh.positions[t[0]]), p1(mesh.positions[t[1]]), p2(mesh.positions[t[2]]);
+              const double model = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
+              // Kept where the chart's map keeps the face oriented as its own faces, unstretched,
+              // and off the faces it holds already.
+              const auto fits = [&](const glm::dvec2 (&uv)[3]) {
+                const double loc = std::max({glm::length(uv[1] - uv[0]), glm::length(uv[2] - uv[1]), glm::length(uv[0] - uv[2])});
+                return sign * signed_area2(uv[0], uv[1], uv[2]) > 0 && loc <= options.max_stretch * model && !grid_overlaps(g, uv);
+              };
+              face_local(g, c, lt.uv);
+              bool ok;
+              if (!unfold) {
+                ok = fits(lt.uv);
+              } else {
+                // Corners placed already keep their place; the others take the projection's.
+                int placed = 0, fresh = -1;
+                for (int j = 0; j < 3; ++j)
+                  if (has_unfolded[t[j]]) lt.uv[j] = unfolded[t[j]], ++placed;
+                  else fresh = j;
+                ok = fits(lt.uv);
+                if (!ok && placed == 2) {
+                  // Where the projection does not fit, the face is unfolded: laid in its own
+                  // shape (a similarity) onto its placed edge (a, b), on the chart's side.
+                  const int ia = (fresh + 1) % 3, ib = (fresh + 2) % 3;
+                  const std::optional<PlaneTriangle> pt = in_own_plane(
+                      glm::dvec3(mesh.positions[t[ia]]), glm::dvec3(mesh.positions[t[ib]]), glm::dvec3(mesh.positions[t[fresh]]));
+                  const glm::dvec2 A = lt.uv[ia], Bq = lt.uv[ib];
+                  const double len = glm::length(Bq - A);
+                  if (pt && len > 0) {
+                    const glm::dvec2 dir = (Bq - A) / len, perp(-dir.y, dir.x);
+                    const double scale = len / pt->l1;
+                    const glm::dvec2 along = A + scale * pt->ex * dir;
+                    const glm::dvec2 x1 = along + scale * pt->ey * perp, x2 = along - scale * pt->ey * perp;
+                    // (a, b, x) is t's order rotated, so its sign is the face's.
+                    lt.uv[fresh] = sign * signed_area2(A, Bq, x1) > 0 ? x1 : x2;
+                    ok = fits(lt.uv);
+                    unfolded_faces += ok;
+                  }
+                }
+                // Not yet: once a neighbour places a second corner, the face may unfold.
+                if (!ok && placed < 2) continue;
+                if (ok)
+                  for (int j = 0; j < 3; ++j)
+                    if (!has_unfolded[t[j]]) {
+                      has_unfolded[t[j]] = 1, unfolded[t[j]] = lt.uv[j];
+                      unfolded_touched.push_back(t[j]);
+                    }
+              }
+              if (ok) insert_wrapped(g, lt.uv);
+              face_state[g] = ok ? 1 : 2;
+              faces.push_back(g);
+              if (!ok) continue;
+              local.push_back(lt);
+              ChartMap& m = maps[c];
+              for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
+            }
+        return unfolded_faces;
+      };
       // 5c. A joint or sheet chart's projection (orthographic, or central onto the sphere of
       // directions) foreshortens every face it sees obliquely, along the direction the face is
       // tilted in, which is not an atlas axis: the blur's per-axis widths cannot follow that, and
       // the map's Laplace-Beltrami operator gains a drift term that no blur carries. A conformal
       // map's is λ⁻² Δ, what the stretch-compensated blur does. So the faces the chart now holds
-      // (its own and its band's: the projection embeds them in the plane without folds) take a
-      // least squares conformal map (Lévy et al. 2002), kept where every one of them keeps its
-      // orientation and its shape (σ1 / σ2 ≤ max_stretch).
-      if (options.conformal && maps[c].kind != Chart::Kind::Bone) {
+      // (its own and its band's, embedded in the plane without folds) take a least squares
+      // conformal map (Lévy et al. 2002), kept where every one of them keeps its orientation and
+      // its shape (σ1 / σ2 ≤ max_stretch).
+      // The unfolded band (to the band's width, or where its map fails, half or a quarter of it)
+      // and the band grown in the projection alone are both mapped, and the chart keeps the one
+      // that reaches farther round its own vertices: the sum over them of the
+      // distance along the surface to where the band's coverage ends, up to the band's width
+      // (what a blur centred on them can use). Unfolding reaches round sharp edges, but where the
+      // chart is small against its band (the band reaches round a small part), the conformal map
+      // of the unfolded band trims more than the projection stops at (CGAL's pipe). Where the
+      // projection's conformal map fails, its band stays in the projection, as before unfolding.
+      const bool conformal_chart = options.conformal && maps[c].kind != Chart::Kind::Bone;
+      const auto undo = [&] {
+        for (std::uint32_t f : faces) face_state[f] = 0;
+        local.resize(band_begin);
+        maps[c].lo = lo_before, maps[c].hi = hi_before;
+        conformal[c].clear();
+        for (std::uint32_t i : held_local[c]) face_local(local[i].face, c, local[i].uv);
+        grid.clear();
+        grid_entries.clear();
+        grid_tris.clear();
+        grid_faces.clear();
+        for (std::uint32_t f : held[c]) {
+          glm::dvec2 uv[3];
+          face_local(f, c, uv);
+          insert_wrapped(f, uv);
+        }
+      };
+      // Grows the band and maps it; the faces the map keeps (0: it failed).
+      // Returns kNothingUnfolded, without a map, when an unfolded band needed no unfolding (the
+      // projection's band is the same).
+      constexpr std::size_t kNothingUnfolded = std::numeric_limits<std::size_t>::max();
+      const auto attempt = [&](bool unfold, double radius) -> std::size_t {
+        if (grow(unfold, radius) == 0 && unfold) {
+          for (std::uint32_t v : unfolded_touched) has_unfolded[v] = 0;
+          unfolded_touched.clear();
+          return kNothingUnfolded;
+        }
         std::vector<std::uint32_t> domain_faces;
         for (std::uint32_t f : faces)
           if (face_state[f] == 1) domain_faces.push_back(f);
         std::vector<std::uint32_t> trimmed;
-        if (conformal_map(c, domain_faces, sign, trimmed)) {
-          // The band faces the map could not keep leave the band.
-          if (!trimmed.empty()) {
-            for (std::uint32_t f : trimmed) face_state[f] = 2;
-            local.erase(std::remove_if(local.begin() + static_cast<std::ptrdiff_t>(band_begin), local.end(),
-                                       [&](const LocalTri& lt) { return face_state[lt.face] == 2; }),
-                        local.end());
+        const bool mapped = conformal_map(c, domain_faces, sign, unfold, trimmed);
+        for (std::uint32_t v : unfolded_touched) has_unfolded[v] = 0;
+        unfolded_touched.clear();
+        if (!mapped) return unfold ? 0 : domain_faces.size();
+        // The band faces the map could not keep leave the band.
+        if (!trimmed.empty()) {
+          for (std::uint32_t f : trimmed) face_state[f] = 2;
+          local.erase(std::remove_if(local.begin() + static_cast<std::ptrdiff_t>(band_begin), local.end(),
+                                     [&](const LocalTri& lt) { return face_state[lt.face] == 2; }),
+                      local.end());
+        }
+        ChartMap& m = maps[c];
+        m.lo = glm::dvec2(std::numeric_limits<double>::infinity());
+        m.hi = -m.lo;
+        const auto refresh = [&](LocalTri& lt) {
+          face_local(lt.face, c, lt.uv);
+          for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
+        };
+        for (std::uint32_t i : held_local[c]) refresh(local[i]);
+        for (std::size_t i = band_begin; i < local.size(); ++i) refresh(local[i]);
+        return domain_faces.size() - trimmed.size();
+      };
+      const auto band_reach = [&] {
+        for (std::uint32_t f : faces)
+          if (face_state[f] == 1)
+            for (std::uint32_t v : mesh.triangles[f])
+              if (!std::isfinite(depth[v])) depth[v] = -1, depth_touched.push_back(v);
+        heap.clear();
+        for (std::uint32_t v : depth_touched) {
+          bool inner = true;
+          for (std::uint32_t k = vf_start[v]; k < vf_start[v + 1] && inner; ++k) inner = face_state[vf[k]] == 1;
+          if (!inner) depth[v] = 0, heap.push_back({0.0, v});
+        }
+        std::make_heap(heap.begin(), heap.end(), std::greater<>());
+        while (!heap.empty()) {
+          std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+          const auto [d, a] = heap.back();
+          heap.pop_back();
+          if (d > depth[a] || d >= options.overlap) continue;
+          for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
+            const std::uint32_t b = adj[k];
+            if (!std::isfinite(depth[b])) continue;  // not covered
+            const double nd = d + glm::length(glm::dvec3(mesh.positions[a]) - glm::dvec3(mesh.positions[b]));
+            if (depth[b] >= 0 && nd >= depth[b]) continue;
+            depth[b] = nd;
+            heap.push_back({nd, b});
+            std::push_heap(heap.begin(), heap.end(), std::greater<>());
           }
-          ChartMap& m = maps[c];
-          m.lo = glm::dvec2(std::numeric_limits<double>::infinity());
-          m.hi = -m.lo;
-          const auto refresh = [&](LocalTri& lt) {
-            face_local(lt.face, c, lt.uv);
-            for (const glm::dvec2& q : lt.uv) m.lo = glm::min(m.lo, q), m.hi = glm::max(m.hi, q);
-          };
-          for (std::uint32_t i : held_local[c]) refresh(local[i]);
-          for (std::size_t i = band_begin; i < local.size(); ++i) refresh(local[i]);
+        }
+        double sum = 0;
+        for (std::uint32_t v : chart_vertices[c]) sum += depth[v] < 0 ? options.overlap : std::min(depth[v], options.overlap);
+        for (std::uint32_t v : depth_touched) depth[v] = std::numeric_limits<double>::infinity();
+        depth_touched.clear();
+        return sum;
+      };
+      if (!conformal_chart) {
+        grow(false, options.overlap);
+      } else {
+        // The unfolded band whose map succeeds: to the band's width, or half, or a quarter.
+        double unfolded_reach = -1.0, radius = options.overlap;
+        for (int k = 0; k < 3 && unfolded_reach < 0; ++k, radius /= 2) {
+          if (k > 0) undo();
+          const std::size_t kept = attempt(true, radius);
+          if (kept == kNothingUnfolded) break;
+          if (kept > 0) unfolded_reach = band_reach();
+        }
+        radius *= 2;
+        undo();
+        attempt(false, options.overlap);
+        if (unfolded_reach > band_reach()) {
+          undo();
+          attempt(true, radius);
         }
       }
       {
