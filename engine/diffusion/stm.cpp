@@ -1045,6 +1045,12 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
       for (long x = x0; x <= x1; ++x)
         for (long y = y0; y <= y1; ++y) fn(cell_key(x, y));
     };
+    const auto grid_clear = [&] {
+      grid.clear();
+      grid_entries.clear();
+      grid_tris.clear();
+      grid_faces.clear();
+    };
     const auto grid_insert = [&](std::uint32_t f, const glm::dvec2 (&uv)[3]) {
       const auto id = static_cast<std::uint32_t>(grid_tris.size());
       grid_tris.push_back({uv[0], uv[1], uv[2]});
@@ -1251,10 +1257,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         // Nor folded over itself (the band's overlap test, on the new coordinates). In an unfolded
         // band, of two faces that overlap, the one farther out (later in the domain) leaves it.
         if (bad.empty()) {
-          grid.clear();
-          grid_entries.clear();
-          grid_tris.clear();
-          grid_faces.clear();
+          grid_clear();
           for (std::uint32_t f : domain) {
             const Triangle& t = mesh.triangles[f];
             const glm::dvec2 uv[3] = {coord(t[0]), coord(t[1]), coord(t[2])};
@@ -1305,15 +1308,16 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
           grid_insert(f, moved);
         }
       };
-      grid.clear();
-      grid_entries.clear();
-      grid_tris.clear();
-      grid_faces.clear();
-      for (std::uint32_t f : held[c]) {
-        glm::dvec2 uv[3];
-        face_local(f, c, uv);
-        insert_wrapped(f, uv);
-      }
+      // The grid holds the faces the chart holds already (and what its band adds).
+      const auto grid_of_held = [&] {
+        grid_clear();
+        for (std::uint32_t f : held[c]) {
+          glm::dvec2 uv[3];
+          face_local(f, c, uv);
+          insert_wrapped(f, uv);
+        }
+      };
+      grid_of_held();
       // Distances along the surface from the chart's vertices, up to the band.
       heap.clear();
       for (std::uint32_t v : chart_vertices[c]) dist[v] = 0, reached.push_back(v), heap.push_back({0.0, v});
@@ -1457,15 +1461,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         maps[c].lo = lo_before, maps[c].hi = hi_before;
         conformal[c].clear();
         for (std::uint32_t i : held_local[c]) face_local(local[i].face, c, local[i].uv);
-        grid.clear();
-        grid_entries.clear();
-        grid_tris.clear();
-        grid_faces.clear();
-        for (std::uint32_t f : held[c]) {
-          glm::dvec2 uv[3];
-          face_local(f, c, uv);
-          insert_wrapped(f, uv);
-        }
+        grid_of_held();
       };
       // Grows the band and maps it; the faces the map keeps (0: it failed).
       // Returns kNothingUnfolded, without a map, when an unfolded band needed no unfolding (the
@@ -1503,33 +1499,40 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         for (std::size_t i = band_begin; i < local.size(); ++i) refresh(local[i]);
         return domain_faces.size() - trimmed.size();
       };
-      const auto band_reach = [&] {
+      // The vertices the band's faces cover (corners of faces in the chart), appended to
+      // `touched`, with into `to_end` their distance along the surface to where the coverage ends
+      // (covered vertices with a face around them the chart lacks), walked up to `limit`; -1
+      // where farther. `to_end` is infinity everywhere else, and the caller resets what it touched.
+      const auto coverage_depth = [&](std::vector<double>& to_end, std::vector<std::uint32_t>& touched, double limit) {
         for (std::uint32_t f : faces)
           if (face_state[f] == 1)
             for (std::uint32_t v : mesh.triangles[f])
-              if (!std::isfinite(depth[v])) depth[v] = -1, depth_touched.push_back(v);
+              if (!std::isfinite(to_end[v])) to_end[v] = -1, touched.push_back(v);
         heap.clear();
-        for (std::uint32_t v : depth_touched) {
+        for (std::uint32_t v : touched) {
           bool inner = true;
           for (std::uint32_t k = vf_start[v]; k < vf_start[v + 1] && inner; ++k) inner = face_state[vf[k]] == 1;
-          if (!inner) depth[v] = 0, heap.push_back({0.0, v});
+          if (!inner) to_end[v] = 0, heap.push_back({0.0, v});
         }
         std::make_heap(heap.begin(), heap.end(), std::greater<>());
         while (!heap.empty()) {
           std::pop_heap(heap.begin(), heap.end(), std::greater<>());
           const auto [d, a] = heap.back();
           heap.pop_back();
-          if (d > depth[a] || d >= options.overlap) continue;
+          if (d > to_end[a] || d >= limit) continue;
           for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
             const std::uint32_t b = adj[k];
-            if (!std::isfinite(depth[b])) continue;  // not covered
+            if (!std::isfinite(to_end[b])) continue;  // not covered
             const double nd = d + glm::length(glm::dvec3(mesh.positions[a]) - glm::dvec3(mesh.positions[b]));
-            if (depth[b] >= 0 && nd >= depth[b]) continue;
-            depth[b] = nd;
+            if (to_end[b] >= 0 && nd >= to_end[b]) continue;
+            to_end[b] = nd;
             heap.push_back({nd, b});
             std::push_heap(heap.begin(), heap.end(), std::greater<>());
           }
         }
+      };
+      const auto band_reach = [&] {
+        coverage_depth(depth, depth_touched, options.overlap);
         double sum = 0;
         for (std::uint32_t v : chart_vertices[c]) sum += depth[v] < 0 ? options.overlap : std::min(depth[v], options.overlap);
         for (std::uint32_t v : depth_touched) depth[v] = std::numeric_limits<double>::infinity();
@@ -1540,52 +1543,26 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         grow(false, options.overlap);
       } else {
         // The unfolded band whose map succeeds: to the band's width, or half, or a quarter.
-        double unfolded_reach = -1.0, radius = options.overlap;
-        for (int k = 0; k < 3 && unfolded_reach < 0; ++k, radius /= 2) {
+        double unfolded_reach = -1.0, unfolded_radius = 0.0;
+        for (int k = 0; k < 3 && unfolded_reach < 0; ++k) {
           if (k > 0) undo();
+          const double radius = std::ldexp(options.overlap, -k);
           const std::size_t kept = attempt(true, radius);
           if (kept == kNothingUnfolded) break;
-          if (kept > 0) unfolded_reach = band_reach();
+          if (kept > 0) unfolded_reach = band_reach(), unfolded_radius = radius;
         }
-        radius *= 2;
         undo();
         attempt(false, options.overlap);
         if (unfolded_reach > band_reach()) {
           undo();
-          attempt(true, radius);
+          attempt(true, unfolded_radius);
         }
       }
       {
         // The vertices the chart covers (corners of its faces), and their distance along the
         // surface to where its coverage ends (covered vertices with a face around them it lacks).
         covered.clear();
-        for (std::uint32_t f : faces)
-          if (face_state[f] == 1)
-            for (std::uint32_t v : mesh.triangles[f])
-              if (!std::isfinite(cover[v])) cover[v] = -1, covered.push_back(v);
-        heap.clear();
-        for (std::uint32_t v : covered) {
-          bool inner = true;
-          for (std::uint32_t k = vf_start[v]; k < vf_start[v + 1] && inner; ++k) inner = face_state[vf[k]] == 1;
-          if (!inner) cover[v] = 0, heap.push_back({0.0, v});
-        }
-        std::make_heap(heap.begin(), heap.end(), std::greater<>());
-        while (!heap.empty()) {
-          std::pop_heap(heap.begin(), heap.end(), std::greater<>());
-          const auto [d, a] = heap.back();
-          heap.pop_back();
-          if (d > cover[a] && cover[a] >= 0) continue;
-          if (d >= blend_reach) continue;
-          for (std::uint32_t k = adj_start[a]; k < adj_start[a + 1]; ++k) {
-            const std::uint32_t b = adj[k];
-            if (std::isfinite(cover[b]) == false) continue;  // not covered
-            const double nd = d + glm::length(glm::dvec3(mesh.positions[a]) - glm::dvec3(mesh.positions[b]));
-            if (cover[b] >= 0 && nd >= cover[b]) continue;
-            cover[b] = nd;
-            heap.push_back({nd, b});
-            std::push_heap(heap.begin(), heap.end(), std::greater<>());
-          }
-        }
+        coverage_depth(cover, covered, blend_reach);
         // The chart's distortion around each covered vertex (StmOptions::blend): the mean over its
         // faces in the chart of log² σ1 + log² σ2, σ1, σ2 the singular values of the map surface ->
         // chart (both in model units, so 1 where the chart keeps lengths).
