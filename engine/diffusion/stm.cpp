@@ -1133,6 +1133,11 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         verts.clear();
       };
       const auto own_face = [&](const Triangle& t) { return vchart[t[0]] == c || vchart[t[1]] == c || vchart[t[2]] == c; };
+      // Edge k of a triangle (corners k, k + 1), whichever way round.
+      const auto edge_key = [](const Triangle& t, int k) {
+        const std::uint32_t a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
+        return (static_cast<std::uint64_t>(a) << 32) | b;
+      };
       std::vector<std::pair<std::uint64_t, std::uint32_t>> edges;
       std::vector<std::uint8_t> joined;
       std::vector<std::uint32_t> reach_queue;
@@ -1144,10 +1149,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         edges.clear();
         for (std::size_t i = 0; i < domain.size(); ++i) {
           const Triangle& t = mesh.triangles[domain[i]];
-          for (int k = 0; k < 3; ++k) {
-            const std::uint32_t a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
-            edges.push_back({(static_cast<std::uint64_t>(a) << 32) | b, static_cast<std::uint32_t>(i)});
-          }
+          for (int k = 0; k < 3; ++k) edges.push_back({edge_key(t, k), static_cast<std::uint32_t>(i)});
         }
         std::sort(edges.begin(), edges.end());
         joined.assign(domain.size(), 0);
@@ -1157,8 +1159,7 @@ Stm build_stm(const Mesh& mesh, const skeleton::Skeleton& skel, const StmOptions
         for (std::size_t q = 0; q < reach_queue.size(); ++q) {
           const Triangle& t = mesh.triangles[domain[reach_queue[q]]];
           for (int k = 0; k < 3; ++k) {
-            const std::uint32_t a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
-            const std::uint64_t key = (static_cast<std::uint64_t>(a) << 32) | b;
+            const std::uint64_t key = edge_key(t, k);
             for (auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(key, std::uint32_t{0}));
                  it != edges.end() && it->first == key; ++it)
               if (!joined[it->second]) joined[it->second] = 1, reach_queue.push_back(it->second);
